@@ -1,0 +1,330 @@
+"""Convex polyhedral block geometry: hulls, faces, mass properties and interface points.
+
+Everything here is plain NumPy/SciPy and runs once, when a model is built. Units are SI: lengths in
+metres, density in kg/m^3, mass in kg, inertia in kg*m^2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import ConvexHull, QhullError
+
+__all__ = [
+    "Polyhedron",
+    "MassProperties",
+    "convex_hull",
+    "box",
+    "mass_properties",
+    "face_points",
+]
+
+_REL_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class Polyhedron:
+    """A convex polyhedron.
+
+    Attributes:
+        vertices: (n, 3) vertex coordinates [m].
+        faces: one int array per face, vertex indices counter-clockwise seen from outside.
+        normals: (f, 3) outward unit normals.
+        offsets: (f,) plane offsets, ``normals[i] @ x <= offsets[i]`` for every point x inside.
+    """
+
+    vertices: NDArray[np.float64]
+    faces: tuple[NDArray[np.int64], ...]
+    normals: NDArray[np.float64]
+    offsets: NDArray[np.float64]
+
+    @property
+    def size(self) -> float:
+        """Diameter of the vertex set [m]."""
+        v = self.vertices
+        return float(np.max(np.linalg.norm(v[:, None, :] - v[None, :, :], axis=-1)))
+
+    def transformed(self, rotation: ArrayLike, translation: ArrayLike) -> "Polyhedron":
+        """Return the polyhedron moved rigidly: x -> R x + t."""
+        r = np.asarray(rotation, dtype=float)
+        t = np.asarray(translation, dtype=float)
+        normals = self.normals @ r.T
+        vertices = self.vertices @ r.T + t
+        offsets = self.offsets + normals @ t
+        return Polyhedron(vertices, self.faces, normals, offsets)
+
+    def contains(self, points: ArrayLike, tol: float = 0.0) -> NDArray[np.bool_]:
+        """Whether points (m, 3) lie inside (within ``tol`` metres of) the polyhedron."""
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        return np.all(p @ self.normals.T - self.offsets <= tol, axis=1)
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Mass properties of a homogeneous solid.
+
+    Attributes:
+        volume: [m^3].
+        mass: [kg].
+        centroid: (3,) [m].
+        inertia: (3, 3) inertia tensor about the centroid, world axes [kg m^2].
+    """
+
+    volume: float
+    mass: float
+    centroid: NDArray[np.float64]
+    inertia: NDArray[np.float64]
+
+
+def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
+    """Build a convex polyhedron from its vertices.
+
+    Coplanar hull triangles are merged into polygonal faces. Every given vertex must be a corner of
+    the hull: a vertex inside the hull means the intended shape is not convex, which rockdem refuses
+    (split such a shape into convex blocks).
+
+    Args:
+        vertices: (n, 3) coordinates [m], n >= 4, not all coplanar.
+        name: used in error messages.
+
+    Raises:
+        ValueError: degenerate (flat, collinear, too few points) or non-convex vertex sets.
+    """
+    v = np.asarray(vertices, dtype=float)
+    if v.ndim != 2 or v.shape[1] != 3 or v.shape[0] < 4:
+        raise ValueError(f"{name}: vertices must be an (n, 3) array with n >= 4, got shape {v.shape}")
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name}: vertices contain NaN or infinite values")
+    scale = float(np.max(np.ptp(v, axis=0)))
+    if scale <= 0.0:
+        raise ValueError(f"{name}: all vertices coincide; give a block of positive size")
+    try:
+        hull = ConvexHull(v)
+    except QhullError as exc:
+        raise ValueError(
+            f"{name}: vertices are flat or degenerate (zero volume); give a block with positive "
+            "extent in all three directions"
+        ) from exc
+    tol = 1e-7 * scale
+    # Group hull triangles by plane.
+    planes: list[tuple[NDArray[np.float64], float, set[int]]] = []
+    for simplex, eq in zip(hull.simplices, hull.equations):
+        n, d = eq[:3], -eq[3]
+        for pn, pd, verts in planes:
+            if np.dot(pn, n) > 1.0 - 1e-9 and abs(pd - d) < tol:
+                verts.update(int(i) for i in simplex)
+                break
+        else:
+            planes.append((n.copy(), float(d), {int(i) for i in simplex}))
+    # Each plane: all input vertices lying on it (catches coplanar points qhull dropped).
+    hull_idx = set(int(i) for i in hull.vertices)
+    for i in range(len(v)):
+        if i in hull_idx:
+            continue
+        dist = min(float(pd - pn @ v[i]) for pn, pd, _ in planes)
+        if dist > tol:
+            raise ValueError(
+                f"{name}: vertex {i} at {v[i].tolist()} lies inside the convex hull of the others, "
+                "so the block is not convex. rockdem blocks are convex polyhedra: split the shape "
+                "into convex blocks."
+            )
+    # Keep only hull vertices, renumbered.
+    keep = sorted(hull_idx)
+    renum = {old: new for new, old in enumerate(keep)}
+    verts = v[keep]
+    faces = []
+    normals = []
+    offsets = []
+    for pn, pd, ids in planes:
+        ids_new = np.array([renum[i] for i in ids if i in renum])
+        pts = verts[ids_new]
+        c = pts.mean(axis=0)
+        a = pts[0] - c
+        a = a - pn * (pn @ a)
+        a /= np.linalg.norm(a)
+        b = np.cross(pn, a)
+        ang = np.arctan2((pts - c) @ b, (pts - c) @ a)
+        order = ids_new[np.argsort(ang)]
+        # Drop vertices collinear with their neighbours (they are not face corners).
+        order = _drop_collinear(verts, order, tol)
+        faces.append(order.astype(np.int64))
+        normals.append(pn / np.linalg.norm(pn))
+        offsets.append(pd)
+    return Polyhedron(verts, tuple(faces), np.array(normals), np.array(offsets))
+
+
+def _drop_collinear(v: NDArray[np.float64], order: NDArray[np.int64], tol: float) -> NDArray[np.int64]:
+    keep = []
+    k = len(order)
+    for j in range(k):
+        p0, p1, p2 = v[order[j - 1]], v[order[j]], v[order[(j + 1) % k]]
+        e1, e2 = p1 - p0, p2 - p1
+        if np.linalg.norm(np.cross(e1, e2)) > tol * (np.linalg.norm(e1) + np.linalg.norm(e2) + 1e-300):
+            keep.append(order[j])
+    return np.array(keep, dtype=np.int64)
+
+
+def box(b: float, l: float, h: float, *, center: ArrayLike = (0.0, 0.0, 0.0), name: str = "box") -> Polyhedron:
+    """Rectangular box of width ``b`` (x), length ``l`` (y) and height ``h`` (z) [m], centred at ``center``."""
+    for field, val in (("b (width, x)", b), ("l (length, y)", l), ("h (height, z)", h)):
+        if not np.isfinite(val) or val <= 0.0:
+            raise ValueError(f"{name}: {field} must be a positive length in metres, got {val!r}")
+    c = np.asarray(center, dtype=float)
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+    return convex_hull(c + 0.5 * signs * np.array([b, l, h]), name=name)
+
+
+def mass_properties(poly: Polyhedron, density: float) -> MassProperties:
+    """Volume, mass, centroid and inertia tensor by the divergence theorem (tetrahedra fan).
+
+    Each face is fanned into triangles which, with a reference point, form signed tetrahedra whose
+    volume, first and second moments are summed exactly.
+    """
+    v = poly.vertices
+    ref = v.mean(axis=0)
+    vol = 0.0
+    first = np.zeros(3)
+    second = np.zeros((3, 3))
+    for f in poly.faces:
+        a = v[f[0]] - ref
+        for j in range(1, len(f) - 1):
+            b = v[f[j]] - ref
+            c = v[f[j + 1]] - ref
+            det = float(np.dot(a, np.cross(b, c)))
+            vol += det / 6.0
+            s = a + b + c
+            first += det / 24.0 * s
+            second += det / 120.0 * (np.outer(a, a) + np.outer(b, b) + np.outer(c, c) + np.outer(s, s))
+    centroid_rel = first / vol
+    cov = second - vol * np.outer(centroid_rel, centroid_rel)
+    inertia = density * (np.trace(cov) * np.eye(3) - cov)
+    return MassProperties(vol, density * vol, ref + centroid_rel, 0.5 * (inertia + inertia.T))
+
+
+def _polygon_area(p: NDArray[np.float64]) -> float:
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def _clip(poly: NDArray[np.float64], clipper: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Sutherland-Hodgman clip of 2D polygon ``poly`` by convex CCW polygon ``clipper``."""
+    out = poly
+    n = len(clipper)
+    for i in range(n):
+        if len(out) == 0:
+            break
+        a, b = clipper[i], clipper[(i + 1) % n]
+        e = b - a
+        inp = out
+        out_list = []
+        side = e[0] * (inp[:, 1] - a[1]) - e[1] * (inp[:, 0] - a[0])
+        m = len(inp)
+        for j in range(m):
+            cur, nxt = inp[j], inp[(j + 1) % m]
+            sc, sn = side[j], side[(j + 1) % m]
+            if sc >= 0:
+                out_list.append(cur)
+            if (sc >= 0) != (sn >= 0):
+                t = sc / (sc - sn)
+                out_list.append(cur + t * (nxt - cur))
+        out = np.array(out_list) if out_list else np.zeros((0, 2))
+    return out
+
+
+def _min_area_rect_axes(p2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Unit axis (2,) of the minimum-area bounding rectangle of a convex polygon (rotating calipers)."""
+    best, best_axis = np.inf, np.array([1.0, 0.0])
+    for i in range(len(p2)):
+        e = p2[(i + 1) % len(p2)] - p2[i]
+        ln = np.linalg.norm(e)
+        if ln == 0.0:
+            continue
+        u = e / ln
+        w = np.array([-u[1], u[0]])
+        area = np.ptp(p2 @ u) * np.ptp(p2 @ w)
+        if area < best * (1.0 - 1e-12):
+            best, best_axis = area, u
+    return best_axis
+
+
+def face_points(
+    poly: Polyhedron, face: int, n_across: int, n_along: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Interface integration points of one face and their tributary areas.
+
+    The face's minimum-area bounding rectangle defines two axes: "across" (the shorter side, the
+    wall thickness for a bed face) and "along" (the longer side). ``n_across x n_along`` nodes are
+    spread evenly over the rectangle *including its edges*, so that 2 x 2 puts the points at the
+    corners of a rectangular face (3DEC's minimal sub-contacts, the paper's "2 contact points").
+    Each node's tributary cell (half cells at the ends, the trapezoidal rule) is clipped to the
+    face polygon; its clipped area is the point's area, so the areas sum exactly to the face area.
+    A node outside a non-rectangular face is moved to its clipped cell's centroid.
+
+    Returns:
+        points (k, 3) [m] and areas (k,) [m^2].
+    """
+    if n_across < 1 or n_along < 1:
+        raise ValueError(f"interface points: need at least 1 point across and along, got {n_across} x {n_along}")
+    v = poly.vertices[poly.faces[face]]
+    n = poly.normals[face]
+    c = v.mean(axis=0)
+    ax = v[1] - v[0]
+    ax = ax - n * (n @ ax)
+    ax /= np.linalg.norm(ax)
+    ay = np.cross(n, ax)
+    p2 = np.column_stack(((v - c) @ ax, (v - c) @ ay))
+    u = _min_area_rect_axes(p2)
+    w = np.array([-u[1], u[0]])
+    su, sw = p2 @ u, p2 @ w
+    if np.ptp(su) > np.ptp(sw):  # make u the short side ("across")
+        u, w = w, -u
+        su, sw = p2 @ u, p2 @ w
+    pts, areas = [], []
+    gu = _nodes(su.min(), su.max(), n_across)
+    gw = _nodes(sw.min(), sw.max(), n_along)
+    size = max(np.ptp(su), np.ptp(sw))
+    for (ucen, ulo, uhi) in gu:
+        for (wcen, wlo, whi) in gw:
+            cell = np.array(
+                [ulo * u + wlo * w, uhi * u + wlo * w, uhi * u + whi * w, ulo * u + whi * w]
+            )
+            clipped = _clip(cell, p2)
+            if len(clipped) < 3:
+                continue
+            area = abs(_polygon_area(clipped))
+            if area <= _REL_TOL * size * size:
+                continue
+            node = ucen * u + wcen * w
+            if not _inside_2d(node, p2, 1e-9 * size):
+                node = _polygon_centroid(clipped)
+            pts.append(c + node[0] * ax + node[1] * ay)
+            areas.append(area)
+    return np.array(pts), np.array(areas)
+
+
+def _nodes(lo: float, hi: float, k: int) -> list[tuple[float, float, float]]:
+    if k == 1:
+        return [(0.5 * (lo + hi), lo, hi)]
+    x = np.linspace(lo, hi, k)
+    h = (hi - lo) / (k - 1)
+    return [(float(xi), max(lo, xi - 0.5 * h), min(hi, xi + 0.5 * h)) for xi in x]
+
+
+def _inside_2d(p: NDArray[np.float64], poly: NDArray[np.float64], tol: float) -> bool:
+    n = len(poly)
+    for i in range(n):
+        a, b = poly[i], poly[(i + 1) % n]
+        e = b - a
+        ln = np.hypot(e[0], e[1])
+        if e[0] * (p[1] - a[1]) - e[1] * (p[0] - a[0]) < -tol * ln:
+            return False
+    return True
+
+
+def _polygon_centroid(p: NDArray[np.float64]) -> NDArray[np.float64]:
+    x, y = p[:, 0], p[:, 1]
+    cross = x * np.roll(y, -1) - np.roll(x, -1) * y
+    a = 0.5 * cross.sum()
+    return np.array([((x + np.roll(x, -1)) * cross).sum(), ((y + np.roll(y, -1)) * cross).sum()]) / (6.0 * a)
