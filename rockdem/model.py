@@ -1,0 +1,529 @@
+"""Model building: blocks, groups, joint materials, damping and prescribed motions -> frozen Model.
+
+A :class:`ModelBuilder` collects blocks with friendly calls and :meth:`ModelBuilder.finalize`
+validates everything once and freezes it into a :class:`Model` of flat arrays
+(:class:`~rockdem.kernels.layout.ModelArrays`) that the kernels use. Units: SI.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .geometry import Polyhedron, box, face_points, mass_properties
+from .kernels.layout import ModelArrays
+from .kernels.rotation import axis_angle_matrix, matrix_to_quat
+from .materials import JointMaterial
+
+__all__ = ["Motion", "Damping", "ModelBuilder", "Model", "GROUND"]
+
+GROUND = "ground"
+"""Value of ``driven`` for blocks attached to the ground: they follow the model's ground motion."""
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A prescribed velocity history v(t) of a driven block (linear between samples, end value held).
+
+    Attributes:
+        time: (n,) increasing sample times [s].
+        velocity: (n, 3) velocity [m/s].
+    """
+
+    time: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.time, dtype=float).reshape(-1)
+        v = np.asarray(self.velocity, dtype=float)
+        if v.ndim == 1:
+            v = v.reshape(-1, 1) * np.array([[1.0, 0.0, 0.0]]) if v.shape[0] == t.shape[0] else v.reshape(1, 3)
+        if t.shape[0] < 1 or v.shape != (t.shape[0], 3):
+            raise ValueError(f"Motion: time (n,) and velocity (n, 3) must match, got {t.shape} and {v.shape}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(v))):
+            raise ValueError("Motion: time and velocity must be finite")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError("Motion: time samples must be strictly increasing")
+        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "velocity", v)
+
+    @classmethod
+    def constant(cls, velocity: ArrayLike, *, start: float = 0.0, stop: float | None = None) -> "Motion":
+        """Constant velocity [m/s] from ``start`` to ``stop`` [s] (at rest outside)."""
+        v = np.asarray(velocity, dtype=float).reshape(3)
+        eps = 1e-9
+        if stop is None:
+            t = [0.0, start, start + eps] if start > 0 else [0.0]
+            vel = [np.zeros(3), np.zeros(3), v] if start > 0 else [v]
+        else:
+            t = [0.0, start, start + eps, stop, stop + eps]
+            vel = [np.zeros(3), np.zeros(3), v, v, np.zeros(3)]
+            if start <= 0:
+                t, vel = [0.0, stop, stop + eps], [v, v, np.zeros(3)]
+        return cls(np.array(t), np.array(vel))
+
+    @classmethod
+    def from_function(cls, func: Callable[[float], ArrayLike], duration: float, sample_dt: float = 1e-4) -> "Motion":
+        """Sample a velocity function v(t) -> (3,) [m/s] every ``sample_dt`` over [0, duration] [s]."""
+        t = np.arange(0.0, duration + sample_dt, sample_dt)
+        return cls(t, np.array([np.asarray(func(ti), dtype=float).reshape(3) for ti in t]))
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Rayleigh and local damping (paper Eq. 4; DESIGN §2).
+
+    Attributes:
+        alpha: mass-proportional coefficient [1/s]: force -alpha m v, moment -alpha I omega.
+        beta: stiffness-proportional coefficient [s]: dashpots beta kn A and beta ks A at every
+            active sub-contact (a joint material's own ``beta`` overrides it).
+        alpha_relative: MP damping on velocities relative to the ground motion instead of absolute
+            ones (3DEC uses absolute velocities).
+        local: Cundall's local (non-viscous) damping coefficient for quasi-static runs only [-].
+    """
+
+    alpha: float = 0.0
+    beta: float = 0.0
+    alpha_relative: bool = False
+    local: float = 0.0
+
+    def validate(self) -> None:
+        for name in ("alpha", "beta", "local"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v >= 0.0):
+                raise ValueError(f"damping.{name} must be a finite non-negative number, got {v!r}")
+        if self.local >= 1.0:
+            raise ValueError(f"damping.local must be below 1 (0.8 is usual for quasi-static runs), got {self.local!r}")
+
+
+@dataclass
+class _Block:
+    name: str
+    poly: Polyhedron
+    density: float
+    group: str
+    driven: bool | str | Motion
+    points: tuple[int, int]
+    velocity: NDArray[np.float64]
+    angular_velocity: NDArray[np.float64]
+    tilt: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
+
+
+@dataclass(frozen=True)
+class Model:
+    """A frozen model: the kernel arrays plus the names and initial state.
+
+    Attributes:
+        arrays: flat arrays used by the kernels.
+        block_names: one name per block.
+        group_names: joint-material groups, index = ``arrays.block_group`` value.
+        faces: per block, the face vertex-index lists (global vertex ids into ``arrays.vertex_local``).
+        position0: (nb, 3) initial centroids [m].
+        quaternion0: (nb, 4) initial orientations (body principal frame -> world).
+        quaternion_ref: (nb, 4) reference orientations from which rotations are measured: the
+            initial ones before any :meth:`ModelBuilder.tilt`.
+        velocity0: (nb, 3) initial velocities [m/s].
+        omega0: (nb, 3) initial angular velocities, body frame [rad/s].
+        damping: the damping options.
+        rocking_axis: (3,) world axis about which ``rocking_angle`` is measured.
+        materials: the material table by group-name pair.
+    """
+
+    arrays: ModelArrays
+    block_names: tuple[str, ...]
+    group_names: tuple[str, ...]
+    faces: tuple[tuple[NDArray[np.int64], ...], ...]
+    position0: NDArray[np.float64]
+    quaternion0: NDArray[np.float64]
+    quaternion_ref: NDArray[np.float64]
+    velocity0: NDArray[np.float64]
+    omega0: NDArray[np.float64]
+    damping: Damping
+    rocking_axis: NDArray[np.float64]
+    materials: dict[tuple[str, str], JointMaterial] = field(default_factory=dict)
+
+    @property
+    def block_count(self) -> int:
+        return len(self.block_names)
+
+    @property
+    def point_count(self) -> int:
+        return int(self.arrays.point_area.shape[0])
+
+    def block_id(self, name: str) -> int:
+        """Index of the block called ``name``."""
+        try:
+            return self.block_names.index(name)
+        except ValueError:
+            raise KeyError(f"no block named {name!r}; blocks are {list(self.block_names)}") from None
+
+    def world_points(self, block: int, local_points: ArrayLike) -> NDArray[np.float64]:
+        """Initial world coordinates of points given in the block's body frame."""
+        from .kernels.rotation import quats_to_matrices
+
+        r = quats_to_matrices(self.quaternion0[block])
+        return np.asarray(local_points, dtype=float) @ r.T + self.position0[block]
+
+    def local_points(self, block: int, world_points: ArrayLike) -> NDArray[np.float64]:
+        """Body-frame coordinates of points given in world coordinates at the initial pose."""
+        from .kernels.rotation import quats_to_matrices
+
+        r = quats_to_matrices(self.quaternion0[block])
+        return (np.asarray(world_points, dtype=float) - self.position0[block]) @ r
+
+
+class ModelBuilder:
+    """Collects blocks, groups and materials, then :meth:`finalize` freezes a :class:`Model`.
+
+    Args:
+        gravity: gravitational acceleration vector [m/s^2]; z is up.
+        points: default interface points per face (across the thickness, along the length).
+    """
+
+    def __init__(self, *, gravity: ArrayLike = (0.0, 0.0, -9.81), points: tuple[int, int] = (2, 2)) -> None:
+        g = np.asarray(gravity, dtype=float).reshape(3)
+        if not np.all(np.isfinite(g)):
+            raise ValueError(f"gravity must be a finite 3-vector [m/s^2], got {gravity!r}")
+        self.gravity = g
+        self.points = _check_points(points, "builder points")
+        self._blocks: list[_Block] = []
+        self._materials: dict[frozenset[str], JointMaterial] = {}
+        self.default_material: JointMaterial | None = None
+        self.ground_motion: Motion | None = None
+        self.body_acceleration: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    # -- blocks -------------------------------------------------------------------------------
+    def add_block(
+        self,
+        poly: Polyhedron,
+        *,
+        density: float = 2000.0,
+        group: str = "block",
+        name: str | None = None,
+        driven: bool | str | Motion = False,
+        points: tuple[int, int] | None = None,
+        velocity: ArrayLike = (0.0, 0.0, 0.0),
+        angular_velocity: ArrayLike = (0.0, 0.0, 0.0),
+    ) -> int:
+        """Add a convex block; returns its id.
+
+        Args:
+            poly: geometry at its initial position [m].
+            density: [kg/m^3] (irrelevant for driven blocks, used for their reported mass).
+            group: joint-material group name.
+            name: unique block name (default ``block<i>``).
+            driven: False for a free block; True (fixed), ``"ground"`` (follows the ground motion,
+                fixed if none) or a :class:`Motion` for a block with prescribed velocity.
+            points: interface points per face (across, along); default the builder's.
+            velocity: initial velocity [m/s]; angular_velocity: initial, world frame [rad/s].
+        """
+        i = len(self._blocks)
+        name = f"block{i}" if name is None else str(name)
+        if any(b.name == name for b in self._blocks):
+            raise ValueError(f"block name {name!r} is used twice; give each block a unique name")
+        if not (math.isfinite(density) and density > 0.0):
+            raise ValueError(f"block {name!r}: density must be positive [kg/m^3], got {density!r}")
+        if not (driven is False or driven is True or driven == GROUND or isinstance(driven, Motion)):
+            raise ValueError(f"block {name!r}: driven must be False, True, 'ground' or a Motion, got {driven!r}")
+        pts = self.points if points is None else _check_points(points, f"block {name!r} points")
+        self._blocks.append(
+            _Block(
+                name,
+                poly,
+                float(density),
+                str(group),
+                driven,
+                pts,
+                np.asarray(velocity, dtype=float).reshape(3),
+                np.asarray(angular_velocity, dtype=float).reshape(3),
+            )
+        )
+        return i
+
+    def add_box(
+        self,
+        b: float,
+        l: float,
+        h: float,
+        *,
+        base_center: ArrayLike = (0.0, 0.0, 0.0),
+        **kwargs: object,
+    ) -> int:
+        """Add a box of width b (x), length l (y), height h (z) [m] whose base centre is ``base_center``."""
+        c = np.asarray(base_center, dtype=float) + np.array([0.0, 0.0, 0.5 * h])
+        name = kwargs.get("name")
+        return self.add_block(box(b, l, h, center=c, name=str(name or "box")), **kwargs)  # type: ignore[arg-type]
+
+    def block(self, i: int | str) -> Polyhedron:
+        """Current geometry of block ``i`` (id or name)."""
+        return self._blocks[self._index(i)].poly
+
+    def transform_block(self, i: int | str, rotation: ArrayLike, about: ArrayLike = (0.0, 0.0, 0.0)) -> None:
+        """Rotate block ``i`` rigidly by matrix ``rotation`` about point ``about`` [m]."""
+        r = np.asarray(rotation, dtype=float)
+        a = np.asarray(about, dtype=float)
+        blk = self._blocks[self._index(i)]
+        blk.poly = blk.poly.transformed(r, a - r @ a)
+
+    def tilt(self, i: int | str, fraction: float, *, direction: ArrayLike = (1.0, 0.0, 0.0)) -> float:
+        """Tilt block ``i`` about its base edge on the ``direction`` side to ``fraction`` of its
+        instability angle (free rocking from a fraction of the instability displacement, paper §3.1).
+
+        The pivot is the lowest edge of the block furthest along the horizontal ``direction``; the
+        block turns about it so that its top moves towards ``direction``. Returns the tilt angle [rad].
+        """
+        blk = self._blocks[self._index(i)]
+        if not (math.isfinite(fraction) and 0.0 <= fraction):
+            raise ValueError(f"tilt fraction must be >= 0, got {fraction!r}")
+        d = np.asarray(direction, dtype=float)
+        up = -self.gravity / np.linalg.norm(self.gravity) if np.linalg.norm(self.gravity) > 0 else np.array([0, 0, 1.0])
+        d = d - up * (up @ d)
+        if np.linalg.norm(d) == 0:
+            raise ValueError("tilt direction must have a horizontal component")
+        d /= np.linalg.norm(d)
+        v = blk.poly.vertices
+        h = v @ up
+        base = v[h <= h.min() + 1e-9 * blk.poly.size]
+        along = base @ d
+        pivot = base[along >= along.max() - 1e-9 * blk.poly.size].mean(axis=0)
+        c = mass_properties(blk.poly, blk.density).centroid
+        rel = c - pivot
+        eta = math.atan2(max(float(-(rel @ d)), 0.0), float(rel @ up))
+        theta = fraction * eta
+        axis = np.cross(up, d)
+        r = axis_angle_matrix(axis, theta)
+        self.transform_block(i, r, about=pivot)
+        blk.tilt = r @ blk.tilt
+        return theta
+
+    # -- materials and loading ----------------------------------------------------------------
+    def set_material(self, group_a: str, group_b: str, material: JointMaterial) -> None:
+        """Joint material between groups ``group_a`` and ``group_b`` (order irrelevant)."""
+        material.validate(f"material {group_a!r}-{group_b!r}")
+        self._materials[frozenset((group_a, group_b))] = material
+
+    def set_ground_motion(self, motion: Motion | None) -> None:
+        """Velocity history of every block added with ``driven="ground"``."""
+        self.ground_motion = motion
+
+    def set_body_acceleration(self, time: ArrayLike, acceleration: ArrayLike) -> None:
+        """Acceleration history a(t) (n, 3) [m/s^2] applied as body force m a(t) on every free block."""
+        t = np.asarray(time, dtype=float).reshape(-1)
+        a = np.asarray(acceleration, dtype=float).reshape(t.shape[0], 3)
+        if np.any(np.diff(t) <= 0) or not (np.all(np.isfinite(t)) and np.all(np.isfinite(a))):
+            raise ValueError("body acceleration: times must increase and values be finite")
+        self.body_acceleration = (t, a)
+
+    # -- freeze -------------------------------------------------------------------------------
+    def finalize(
+        self,
+        *,
+        damping: Damping = Damping(),
+        contact_tolerance: float | None = None,
+        rocking_axis: ArrayLike = (0.0, 1.0, 0.0),
+    ) -> Model:
+        """Validate and freeze the model.
+
+        Args:
+            damping: Rayleigh / local damping.
+            contact_tolerance: gap [m] within which sub-contacts are tracked between detections;
+                default 1 % of the smallest block dimension. The point-in-face test uses a tenth.
+            rocking_axis: world axis of the recorded ``rocking_angle`` (default y: rocking in x-z).
+        """
+        if not self._blocks:
+            raise ValueError("the model has no blocks; add blocks before finalize()")
+        damping.validate()
+        if not any(b.driven is False for b in self._blocks):
+            raise ValueError("the model has no free block: every block is driven")
+        groups = sorted({b.group for b in self._blocks})
+        gi = {g: k for k, g in enumerate(groups)}
+        ng = len(groups)
+        mats: dict[tuple[str, str], JointMaterial] = {}
+        for ga in groups:
+            for gb in groups:
+                mat = self._materials.get(frozenset((ga, gb)), self.default_material)
+                if mat is None:
+                    raise ValueError(
+                        f"no joint material between groups {ga!r} and {gb!r}: call "
+                        "set_material(...) for that pair or set builder.default_material"
+                    )
+                mats[(ga, gb)] = mat
+        tables = {name: np.zeros((ng, ng)) for name in ("kn", "ks", "c", "ft", "tf", "rc", "rtf", "beta")}
+        bonded = np.zeros((ng, ng), dtype=np.bool_)
+        for (ga, gb), mat in mats.items():
+            a, b = gi[ga], gi[gb]
+            tables["kn"][a, b] = mat.kn
+            tables["ks"][a, b] = mat.shear_stiffness
+            tables["c"][a, b] = mat.cohesion
+            tables["ft"][a, b] = mat.tension
+            tables["tf"][a, b] = mat.tan_friction
+            tables["rc"][a, b] = mat.residual_cohesion
+            tables["rtf"][a, b] = mat.tan_residual_friction
+            tables["beta"][a, b] = damping.beta if mat.beta is None else mat.beta
+            bonded[a, b] = mat.bonded
+
+        motions: list[Motion] = []
+        ground_index = -1
+        if self.ground_motion is not None:
+            motions.append(self.ground_motion)
+            ground_index = 0
+        block_motion = []
+        for blk in self._blocks:
+            if isinstance(blk.driven, Motion):
+                motions.append(blk.driven)
+                block_motion.append(len(motions) - 1)
+            elif blk.driven == GROUND:
+                block_motion.append(ground_index)
+            else:
+                block_motion.append(-1)
+
+        nb = len(self._blocks)
+        mass = np.zeros(nb)
+        inertia = np.zeros((nb, 3))
+        pos0 = np.zeros((nb, 3))
+        quat0 = np.zeros((nb, 4))
+        quat_ref = np.zeros((nb, 4))
+        vel0 = np.zeros((nb, 3))
+        om0 = np.zeros((nb, 3))
+        radius = np.zeros(nb)
+        vstart, fstart, estart, pstart = [0], [0], [0], [0]
+        vloc, fnorm, foff, farea, enorm, eoff, ploc, parea, pblock = [], [], [], [], [], [], [], [], []
+        faces_out = []
+        min_dim = np.inf
+        for b, blk in enumerate(self._blocks):
+            mp = mass_properties(blk.poly, blk.density)
+            if not mp.volume > 0:
+                raise ValueError(f"block {blk.name!r}: non-positive volume {mp.volume!r} m^3")
+            evals, evecs = np.linalg.eigh(mp.inertia)
+            if np.linalg.det(evecs) < 0:
+                evecs[:, 2] *= -1.0
+            rot = evecs  # columns: principal axes in world; body -> world
+            mass[b], inertia[b], pos0[b] = mp.mass, evals, mp.centroid
+            quat0[b] = matrix_to_quat(rot)
+            quat_ref[b] = matrix_to_quat(blk.tilt.T @ rot)
+            free = blk.driven is False
+            vel0[b] = blk.velocity if free else 0.0
+            om0[b] = rot.T @ blk.angular_velocity if free else 0.0
+            local = (blk.poly.vertices - mp.centroid) @ rot
+            radius[b] = float(np.max(np.linalg.norm(local, axis=1)))
+            extents = np.ptp(local, axis=0)
+            min_dim = min(min_dim, float(extents.min()))
+            base_v = vstart[-1]
+            vloc.append(local)
+            vstart.append(base_v + len(local))
+            faces_out.append(tuple(f + base_v for f in blk.poly.faces))
+            nrm_local = blk.poly.normals @ rot
+            for k, fverts in enumerate(blk.poly.faces):
+                n = nrm_local[k]
+                fv = local[fverts]
+                fnorm.append(n)
+                foff.append(float(n @ fv[0]))
+                pts, areas = face_points(blk.poly, k, *blk.points)
+                farea.append(float(areas.sum()))
+                for j in range(len(fv)):
+                    e = fv[(j + 1) % len(fv)] - fv[j]
+                    m_ = np.cross(e, n)
+                    m_ /= np.linalg.norm(m_)
+                    enorm.append(m_)
+                    eoff.append(float(m_ @ fv[j]))
+                estart.append(estart[-1] + len(fv))
+                ploc.append((pts - mp.centroid) @ rot)
+                parea.append(areas)
+                pblock.append(np.full(len(areas), b))
+                pstart.append(pstart[-1] + len(areas))
+            fstart.append(fstart[-1] + len(blk.poly.faces))
+
+        free_mask = np.array([blk.driven is False for blk in self._blocks])
+        if contact_tolerance is None:
+            contact_tolerance = 0.01 * min_dim
+        if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
+            raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
+        motion_t = np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0)
+        motion_v = np.concatenate([mo.velocity for mo in motions]) if motions else np.zeros((0, 3))
+        mstart = np.cumsum([0] + [len(mo.time) for mo in motions]).astype(np.int64)
+        bt, ba = self.body_acceleration if self.body_acceleration is not None else (np.zeros(0), np.zeros((0, 3)))
+        axis = np.asarray(rocking_axis, dtype=float).reshape(3)
+        if not np.linalg.norm(axis) > 0:
+            raise ValueError("rocking_axis must be a non-zero 3-vector")
+        arrays = ModelArrays(
+            block_mass=mass,
+            block_inv_mass=np.where(free_mask, 1.0 / mass, 0.0),
+            block_inertia=inertia,
+            block_inv_inertia=np.where(free_mask[:, None], 1.0 / inertia, 0.0),
+            block_free=free_mask,
+            block_motion=np.array(block_motion, dtype=np.int64),
+            block_group=np.array([gi[blk.group] for blk in self._blocks], dtype=np.int64),
+            block_radius=radius,
+            block_vertex_start=np.array(vstart, dtype=np.int64),
+            vertex_local=np.concatenate(vloc),
+            block_face_start=np.array(fstart, dtype=np.int64),
+            face_normal=np.array(fnorm),
+            face_offset=np.array(foff),
+            face_area=np.array(farea),
+            face_edge_start=np.array(estart, dtype=np.int64),
+            edge_normal=np.array(enorm),
+            edge_offset=np.array(eoff),
+            face_point_start=np.array(pstart, dtype=np.int64),
+            point_local=np.concatenate(ploc),
+            point_area=np.concatenate(parea),
+            point_block=np.concatenate(pblock).astype(np.int64),
+            mat_kn=tables["kn"],
+            mat_ks=tables["ks"],
+            mat_cohesion=tables["c"],
+            mat_tension=tables["ft"],
+            mat_tan_friction=tables["tf"],
+            mat_res_cohesion=tables["rc"],
+            mat_res_tan_friction=tables["rtf"],
+            mat_beta=tables["beta"],
+            mat_bonded=bonded,
+            gravity=self.gravity.copy(),
+            alpha=float(damping.alpha),
+            alpha_relative=bool(damping.alpha_relative),
+            local_damping=float(damping.local),
+            motion_start=mstart,
+            motion_time=motion_t,
+            motion_velocity=motion_v,
+            ground_motion=int(ground_index),
+            body_time=bt,
+            body_acceleration=ba,
+            contact_tol=float(contact_tolerance),
+            edge_tol=0.1 * float(contact_tolerance),
+        )
+        return Model(
+            arrays=arrays,
+            block_names=tuple(b.name for b in self._blocks),
+            group_names=tuple(groups),
+            faces=tuple(faces_out),
+            position0=pos0,
+            quaternion0=quat0,
+            quaternion_ref=quat_ref,
+            velocity0=vel0,
+            omega0=om0,
+            damping=damping,
+            rocking_axis=axis / np.linalg.norm(axis),
+            materials=mats,
+        )
+
+    def _index(self, i: int | str) -> int:
+        if isinstance(i, str):
+            for k, b in enumerate(self._blocks):
+                if b.name == i:
+                    return k
+            raise KeyError(f"no block named {i!r}")
+        if not 0 <= i < len(self._blocks):
+            raise IndexError(f"block id {i} out of range (0..{len(self._blocks) - 1})")
+        return i
+
+
+def _check_points(points: Sequence[int], what: str) -> tuple[int, int]:
+    try:
+        a, b = (int(points[0]), int(points[1]))
+    except (TypeError, ValueError, IndexError):
+        raise ValueError(f"{what}: give (across, along) interface point counts, got {points!r}") from None
+    if a < 1 or b < 1 or a != points[0] or b != points[1]:
+        raise ValueError(f"{what}: counts must be integers >= 1 (the paper uses 2..15 across), got {points!r}")
+    return a, b

@@ -1,0 +1,599 @@
+"""Earthquake ground-motion records: reading, unit conversion and simple processing.
+
+Readers convert to SI (m/s^2) once, at read time; everything downstream works in SI. Supported files:
+PEER NGA AT2 (NGA-West2 and older PEER headers, the "Peknold" 8F10.5 variant), two-column
+time/acceleration text or CSV files, and single-column files with a separately given time step.
+A :class:`GroundMotion` is immutable: processing methods (scaling, baseline correction, tail,
+resampling) return new records. Integration uses the trapezoid rule, starting from rest.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field, replace
+from enum import StrEnum
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import cumulative_trapezoid
+
+__all__ = [
+    "STANDARD_GRAVITY",
+    "AccelerationUnit",
+    "RecordFormat",
+    "GroundMotion",
+    "read_at2",
+    "read_columns",
+    "read_single_column",
+    "read_record",
+    "shared_record_path",
+]
+
+STANDARD_GRAVITY = 9.80665
+"""Standard gravity g [m/s^2], used to convert records given in g."""
+
+DT_RTOL = 1e-6
+"""Relative tolerance on the spacing of a time column, as a fraction of dt."""
+
+_HEADER_SCAN_LINES = 12  # an AT2 header (NPTS/DT line included) must lie within the first lines
+
+
+class AccelerationUnit(StrEnum):
+    """Units an acceleration record may be written in."""
+
+    G = "g"
+    M_S2 = "m/s2"
+    CM_S2 = "cm/s2"
+
+    @property
+    def to_si(self) -> float:
+        """Factor converting a value in this unit to m/s^2."""
+        return {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}[self.value]
+
+
+class RecordFormat(StrEnum):
+    """Closed set of record file formats."""
+
+    AT2 = "at2"
+    COLUMNS = "columns"
+    SINGLE = "single"
+
+
+_UNIT_ALIASES = {
+    "g": AccelerationUnit.G, "g's": AccelerationUnit.G,
+    "m/s2": AccelerationUnit.M_S2, "m/s^2": AccelerationUnit.M_S2, "m/s/s": AccelerationUnit.M_S2,
+    "m/s**2": AccelerationUnit.M_S2, "m/sec/sec": AccelerationUnit.M_S2, "m/sec2": AccelerationUnit.M_S2,
+    "cm/s2": AccelerationUnit.CM_S2, "cm/s^2": AccelerationUnit.CM_S2, "cm/s/s": AccelerationUnit.CM_S2,
+    "cm/s**2": AccelerationUnit.CM_S2, "cm/sec/sec": AccelerationUnit.CM_S2,
+    "cm/sec2": AccelerationUnit.CM_S2, "gal": AccelerationUnit.CM_S2,
+}
+
+
+def _parse_units(units: str | AccelerationUnit, where: str = "units") -> AccelerationUnit:
+    key = str(units).strip().lower().replace(" ", "").replace("sec", "s") if units is not None else ""
+    unit = _UNIT_ALIASES.get(key) or _UNIT_ALIASES.get(str(units).strip().lower())
+    if unit is None:
+        raise ValueError(f"{where}: unknown acceleration units {units!r}; use 'g', 'm/s2' or 'cm/s2'")
+    return unit
+
+
+# One number: optional sign, mantissa, optional E or Fortran D exponent. Numbers may run together when a
+# sign that is not part of an exponent starts the next one: "1.234-5.678", ".1E-02-.2E-03".
+_UNSIGNED = r"(?:\d+\.?\d*|\.\d+)(?:[EeDd][+-]?\d+)?"
+_NUMBER_RE = re.compile(rf"[+-]?{_UNSIGNED}")
+_TOKEN_RE = re.compile(rf"[+-]?{_UNSIGNED}(?:[+-]{_UNSIGNED})*")
+_SPLIT_RE = re.compile(r"[\s,]+")
+
+
+def _parse_numbers(text: str, *, path: Path, lineno: int, delimiter: str | None = None) -> list[float]:
+    """Numbers on one line, stuck-together values split; ValueError naming file, line and token."""
+    pieces = _SPLIT_RE.split(text.strip()) if delimiter is None else [p.strip() for p in text.split(delimiter)]
+    while pieces and not pieces[-1]:
+        pieces.pop()  # a trailing delimiter ends the line, it does not open an empty column
+    values: list[float] = []
+    for token in pieces:
+        if not token and delimiter is None:
+            continue
+        if not _TOKEN_RE.fullmatch(token):
+            raise ValueError(
+                f"{path}, line {lineno}: cannot read {token!r} as a number (line text: {text.strip()!r})"
+            )
+        values.extend(float(s.replace("D", "E").replace("d", "e")) for s in _NUMBER_RE.findall(token))
+    return values
+
+
+def _is_numeric_line(text: str, delimiter: str | None) -> bool:
+    pieces = _SPLIT_RE.split(text.strip()) if delimiter is None else [p.strip() for p in text.split(delimiter)]
+    while pieces and not pieces[-1]:
+        pieces.pop()
+    return bool(pieces) and all(_TOKEN_RE.fullmatch(p) for p in pieces if p or delimiter is not None)
+
+
+def _read_lines(path: str | os.PathLike[str]) -> tuple[Path, list[str]]:
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"ground-motion file not found: {p} (check the path; for the shared records "
+                                "use rockdem.records.shared_record_path(name))")
+    lines = p.read_text(encoding="utf-8", errors="replace").splitlines()
+    if not any(line.strip() for line in lines):
+        raise ValueError(f"{p} is empty: a ground-motion file needs at least two acceleration values")
+    return p, lines
+
+
+@dataclass(frozen=True, eq=False)
+class GroundMotion:
+    """A uniformly sampled earthquake acceleration record in SI units.
+
+    Attributes:
+        acceleration: (n,) horizontal ground acceleration [m/s^2], applied along ``direction``.
+        dt: time step [s], > 0.
+        name: short identifier (the file stem for records read from files).
+        source: file the record was read from, or None.
+        units_in: units the values had in the source, before conversion to m/s^2.
+        description: free text from the file header (event, station, component).
+        start_time: time of the first sample [s]; ``time = start_time + dt * arange(n)``.
+        direction: (3,) horizontal unit vector along which ``acceleration`` acts; z is up.
+        vertical: (n,) optional vertical ground acceleration [m/s^2], positive up, or None.
+    """
+
+    acceleration: NDArray[np.float64]
+    dt: float
+    name: str = ""
+    source: Path | None = None
+    units_in: str = AccelerationUnit.M_S2.value
+    description: str = ""
+    start_time: float = 0.0
+    direction: NDArray[np.float64] = field(default_factory=lambda: np.array([1.0, 0.0, 0.0]))
+    vertical: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        label = self.name or "GroundMotion"
+        dt = float(self.dt)
+        if not np.isfinite(dt) or dt <= 0.0:
+            raise ValueError(f"{label}: dt must be a positive time step in seconds, got {self.dt!r}")
+        if not np.isfinite(self.start_time):
+            raise ValueError(f"{label}: start_time must be finite, got {self.start_time!r}")
+        acc = _frozen_samples(self.acceleration, "acceleration", label)
+        vertical = None
+        if self.vertical is not None:
+            vertical = _frozen_samples(self.vertical, "vertical", label)
+            if vertical.shape != acc.shape:
+                raise ValueError(f"{label}: vertical has {vertical.size} samples but acceleration has "
+                                 f"{acc.size}; give both on the same time grid")
+        d = np.array(self.direction, dtype=float).reshape(-1)
+        norm = float(np.linalg.norm(d)) if d.shape == (3,) and np.all(np.isfinite(d)) else 0.0
+        if norm == 0.0:
+            raise ValueError(f"{label}: direction must be a finite non-zero 3-vector, got {self.direction!r}")
+        if abs(d[2]) > 1e-9 * norm:
+            raise ValueError(f"{label}: direction must be horizontal (z is up), got {self.direction!r}; "
+                             "give vertical motion as `vertical`")
+        d = d / norm
+        d[2] = 0.0
+        d.setflags(write=False)
+        object.__setattr__(self, "dt", dt)
+        object.__setattr__(self, "start_time", float(self.start_time))
+        object.__setattr__(self, "acceleration", acc)
+        object.__setattr__(self, "vertical", vertical)
+        object.__setattr__(self, "direction", d)
+        object.__setattr__(self, "units_in", _parse_units(self.units_in, f"{label}: units_in").value)
+
+    @classmethod
+    def from_samples(cls, values: ArrayLike, *, dt: float, units: str | AccelerationUnit,
+                     name: str = "", **kwargs: object) -> GroundMotion:
+        """Build a record from samples in any supported unit, converting them to m/s^2.
+
+        Args:
+            values: (n,) acceleration samples in ``units``.
+            dt: time step [s].
+            units: "g", "m/s2" or "cm/s2".
+            name: identifier.
+            **kwargs: other :class:`GroundMotion` fields (source, description, start_time, direction).
+        """
+        unit = _parse_units(units)
+        acc = np.asarray(values, dtype=float) * unit.to_si
+        return cls(acc, dt, name=name, units_in=unit.value, **kwargs)  # type: ignore[arg-type]
+
+    def __repr__(self) -> str:
+        return (f"GroundMotion(name={self.name!r}, npts={self.npts}, dt={self.dt:g} s, "
+                f"duration={self.duration:g} s, pga={self.pga_g:.4f} g, units_in={self.units_in!r})")
+
+    @property
+    def npts(self) -> int:
+        """Number of samples n."""
+        return int(self.acceleration.size)
+
+    @property
+    def time(self) -> NDArray[np.float64]:
+        """(n,) sample times [s]."""
+        return self.start_time + self.dt * np.arange(self.npts)
+
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last sample, (n - 1) * dt [s]."""
+        return (self.npts - 1) * self.dt
+
+    @property
+    def pga(self) -> float:
+        """Peak ground acceleration max |a| of the horizontal component [m/s^2]."""
+        return float(np.max(np.abs(self.acceleration)))
+
+    @property
+    def pga_g(self) -> float:
+        """Peak ground acceleration in units of standard gravity [g]."""
+        return self.pga / STANDARD_GRAVITY
+
+    @property
+    def pga_time(self) -> float:
+        """Time of the (first) peak of |a| [s]."""
+        return self.start_time + self.dt * int(np.argmax(np.abs(self.acceleration)))
+
+    def scaled(self, factor: float) -> GroundMotion:
+        """Return the record with horizontal and vertical accelerations multiplied by ``factor``."""
+        if not np.isfinite(factor):
+            raise ValueError(f"{self.name}: scale factor must be finite, got {factor!r}")
+        vertical = None if self.vertical is None else self.vertical * factor
+        return replace(self, acceleration=self.acceleration * factor, vertical=vertical)
+
+    def scaled_to_pga(self, pga: float) -> GroundMotion:
+        """Return the record scaled so that its horizontal PGA equals ``pga`` [m/s^2].
+
+        The vertical component, if any, gets the same factor (the V/H ratio is kept).
+        """
+        if not np.isfinite(pga) or pga <= 0.0:
+            raise ValueError(f"{self.name}: target pga must be positive, in m/s^2, got {pga!r}")
+        if self.pga == 0.0:
+            raise ValueError(f"{self.name}: the record is all zeros and cannot be scaled to a PGA")
+        return self.scaled(pga / self.pga)
+
+    def with_tail(self, seconds: float) -> GroundMotion:
+        """Return the record followed by a free-vibration tail of zero acceleration.
+
+        Args:
+            seconds: tail length [s] >= 0; rounded to a whole number of steps of the same dt.
+        """
+        if not np.isfinite(seconds) or seconds < 0.0:
+            raise ValueError(f"{self.name}: tail length must be >= 0 seconds, got {seconds!r}")
+        zeros = np.zeros(int(round(seconds / self.dt)))
+        vertical = None if self.vertical is None else np.concatenate([self.vertical, zeros])
+        return replace(self, acceleration=np.concatenate([self.acceleration, zeros]), vertical=vertical)
+
+    def with_direction(self, direction: ArrayLike) -> GroundMotion:
+        """Return the record applied along another horizontal ``direction`` (3-vector, normalised)."""
+        return replace(self, direction=np.asarray(direction, dtype=float))
+
+    def baseline_corrected(self, order: int = 1) -> GroundMotion:
+        """Return the record with a polynomial velocity baseline removed.
+
+        The velocity v(t) (trapezoid integral of a, v(t0) = 0) is fitted in the least-squares sense by
+        a polynomial p(t) of degree ``order`` (constant term included), and the acceleration becomes
+        a(t) - p'(t) at every sample. For ``order`` <= 2, p' is at most linear, which the trapezoid rule
+        integrates exactly, so the corrected velocity is exactly v(t) - p(t) + p(t0): its least-squares
+        trend is gone and it ends near zero. ``order=1`` removes a constant acceleration offset.
+        The vertical component, if any, is corrected the same way, separately.
+
+        Args:
+            order: degree of the velocity polynomial, 1 <= order < npts.
+        """
+        if int(order) != order or not 1 <= order < self.npts:
+            raise ValueError(f"{self.name}: baseline order must be an integer in [1, {self.npts - 1}], "
+                             f"got {order!r}")
+        # Fit on t - t0 scaled to [0, 1] to keep the polynomial basis well conditioned.
+        span = max(self.duration, self.dt)
+        s = (self.time - self.start_time) / span
+
+        def corrected(acc: NDArray[np.float64]) -> NDArray[np.float64]:
+            vel = cumulative_trapezoid(acc, dx=self.dt, initial=0.0)
+            fit = np.polynomial.Polynomial.fit(s, vel, int(order), domain=[0.0, 1.0], window=[0.0, 1.0])
+            return acc - fit.deriv()(s) / span
+
+        vertical = None if self.vertical is None else corrected(self.vertical)
+        return replace(self, acceleration=corrected(self.acceleration), vertical=vertical)
+
+    def resampled(self, dt: float) -> GroundMotion:
+        """Return the record linearly interpolated onto a new time step ``dt`` [s].
+
+        The new grid starts at the same time and stops at or before the last sample. No anti-alias
+        filter is applied, so coarsening a record can lose or alias its high-frequency content.
+        """
+        if not np.isfinite(dt) or dt <= 0.0:
+            raise ValueError(f"{self.name}: dt must be a positive time step in seconds, got {dt!r}")
+        n = int(np.floor(self.duration / dt * (1.0 + 1e-12))) + 1
+        t_new = self.start_time + dt * np.arange(n)
+        t_old = self.time
+        vertical = None if self.vertical is None else np.interp(t_new, t_old, self.vertical)
+        return replace(self, acceleration=np.interp(t_new, t_old, self.acceleration), dt=dt, vertical=vertical)
+
+    def velocity(self) -> NDArray[np.float64]:
+        """(n,) horizontal ground velocity [m/s], trapezoid integral of the acceleration from rest."""
+        return cumulative_trapezoid(self.acceleration, dx=self.dt, initial=0.0)
+
+    def displacement(self) -> NDArray[np.float64]:
+        """(n,) horizontal ground displacement [m], trapezoid integral of the velocity from zero."""
+        return cumulative_trapezoid(self.velocity(), dx=self.dt, initial=0.0)
+
+    def vector_acceleration(self) -> NDArray[np.float64]:
+        """(n, 3) ground acceleration [m/s^2]: a(t) * direction, plus the vertical component on z."""
+        out = self.acceleration[:, None] * self.direction[None, :]
+        if self.vertical is not None:
+            out[:, 2] += self.vertical
+        return out
+
+    def vector_velocity(self) -> NDArray[np.float64]:
+        """(n, 3) ground velocity [m/s], trapezoid integral of :meth:`vector_acceleration` from rest."""
+        return cumulative_trapezoid(self.vector_acceleration(), dx=self.dt, axis=0, initial=0.0)
+
+
+def _frozen_samples(values: ArrayLike, what: str, label: str) -> NDArray[np.float64]:
+    arr = np.array(values, dtype=float)
+    if arr.ndim != 1 or arr.size < 2:
+        raise ValueError(f"{label}: {what} must be a 1-D array of at least 2 samples, got shape {arr.shape}")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise ValueError(f"{label}: {what} has {bad.size} non-finite value(s) (NaN or inf), first at "
+                         f"sample {bad[0]}; clean the record before use")
+    arr.setflags(write=False)
+    return arr
+
+
+# --------------------------------------------------------------------------------------------------- readers
+
+_NPTS_RE = re.compile(r"NPTS\s*[=:]\s*(\d+)", re.IGNORECASE)
+_DT_RE = re.compile(rf"(?<![A-Za-z])DT\s*[=:]\s*([+-]?{_UNSIGNED})", re.IGNORECASE)
+# Older PEER header: "  4000    0.01000   NPTS, DT"
+_OLD_NPTS_DT_RE = re.compile(rf"^\s*(\d+)[\s,]+({_UNSIGNED})\s+NPTS\s*,?\s*DT", re.IGNORECASE)
+_UNITS_RE = re.compile(r"UNITS\s+(?:OF|ARE|IN|:)?\s*\(?\s*([A-Za-z'/^*0-9]+)", re.IGNORECASE)
+_NOT_ACCEL_RE = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b.*\bUNITS?\b", re.IGNORECASE)
+
+
+def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, AccelerationUnit | None]:
+    """Line index of the NPTS/DT line, NPTS, DT [s] and the header's units (None if not stated)."""
+    for i, line in enumerate(lines[:_HEADER_SCAN_LINES]):
+        m_n, m_dt = _NPTS_RE.search(line), _DT_RE.search(line)
+        old = _OLD_NPTS_DT_RE.search(line)
+        if m_n and m_dt:
+            npts, dt_text = int(m_n.group(1)), m_dt.group(1)
+        elif old:
+            npts, dt_text = int(old.group(1)), old.group(2)
+        else:
+            continue
+        dt = float(dt_text.replace("D", "E").replace("d", "e"))
+        header_units = None
+        for head in lines[:i]:
+            if _NOT_ACCEL_RE.search(head):
+                raise ValueError(f"{p}: the header says {head.strip()!r}; rockdem reads acceleration records "
+                                 "(use the matching .AT2 acceleration file)")
+            m_u = _UNITS_RE.search(head)
+            if m_u:
+                header_units = _parse_units(m_u.group(1).rstrip(").,"), f"{p}: header units")
+        return i, npts, dt, header_units
+    raise ValueError(f"{p}: no 'NPTS= ..., DT= ...' header line in the first {_HEADER_SCAN_LINES} lines; "
+                     "for a headerless file use read_single_column(path, dt=..., units=...) or read_columns")
+
+
+def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | None = None,
+             dt: float | None = None) -> GroundMotion:
+    """Read a PEER NGA ``.AT2`` acceleration record.
+
+    Header variants: NGA-West2 (``NPTS=  5372, DT=   .0100 SEC,``), the Peknold 8F10.5 file
+    (``NPTS=  1559, DT= .02000 SEC``), any case, comma or ``SEC`` optional, and the older PEER
+    ``4000  0.01000  NPTS, DT``. Values may be in E, D or plain format, any number per line, and may run
+    together when a sign starts the next one (``1.234-5.678``, ``.1E-02-.2E-03``).
+
+    Args:
+        path: the file.
+        units: units of the values. Default: those the header states ("UNITS OF G", "units are (g)"),
+            else g. An explicit value that contradicts the header is an error.
+        dt: time step [s] overriding the header's (which some files round, e.g. ``.0029``).
+
+    Returns:
+        The record in m/s^2, named after the file stem, with header line 2 as description.
+
+    Raises:
+        FileNotFoundError: missing file.
+        ValueError: no NPTS/DT line, unparsable value (file, line number and text given), value count
+            different from NPTS, bad units or dt.
+    """
+    p, lines = _read_lines(path)
+    i_head, npts, dt_head, header_units = _at2_header(p, lines)
+    unit = header_units or AccelerationUnit.G
+    if units is not None:
+        unit = _parse_units(units, f"{p}: units")
+        if header_units is not None and unit != header_units:
+            raise ValueError(f"{p}: units={str(units)!r} contradicts the header, which says "
+                             f"{header_units.value!r}; omit units to use the header's")
+    values: list[float] = []
+    for k in range(i_head + 1, len(lines)):
+        if lines[k].strip():
+            values.extend(_parse_numbers(lines[k], path=p, lineno=k + 1))
+    if len(values) != npts:
+        raise ValueError(f"{p}: header (line {i_head + 1}) says NPTS={npts} but {len(values)} values were read")
+    step = dt_head if dt is None else dt
+    if not np.isfinite(step) or step <= 0.0:
+        raise ValueError(f"{p}: dt must be positive, got {step!r} (pass dt=... to override the header)")
+    # NGA files put the event and station on line 2 under a fixed banner; other variants on line 1.
+    banner = lines[0].strip().upper().startswith("PEER")
+    description = lines[1].strip() if banner and i_head >= 2 else lines[0].strip() if i_head >= 1 else ""
+    return GroundMotion.from_samples(values, dt=step, units=unit, name=p.stem, source=p,
+                                     description=description)
+
+
+def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit, time_column: int = 0,
+                 acc_column: int = 1, delimiter: str | None = None,
+                 skip_comments: str | None = "#") -> GroundMotion:
+    """Read a time/acceleration text or CSV file with a uniform time step.
+
+    Lines starting with ``skip_comments`` are skipped anywhere (text after it on a data line is
+    dropped too); blank lines are skipped; non-numeric lines are skipped only before the first data
+    line (column titles). The time step is checked to be uniform within ``DT_RTOL * dt``.
+
+    Args:
+        path: the file.
+        units: units of the acceleration column: "g", "m/s2" or "cm/s2".
+        time_column: zero-based index of the time column [s].
+        acc_column: zero-based index of the acceleration column.
+        delimiter: column separator; None for commas and/or whitespace.
+        skip_comments: comment marker, or None.
+
+    Returns:
+        The record in m/s^2 with ``start_time`` the first time and dt the mean step.
+
+    Raises:
+        FileNotFoundError: missing file.
+        ValueError: unparsable line, missing column, time not increasing or not uniform (line named).
+    """
+    p, lines = _read_lines(path)
+    unit = _parse_units(units, f"{p}: units")
+    rows: list[list[float]] = []
+    linenos: list[int] = []
+    comments: list[str] = []
+    need = max(time_column, acc_column) + 1
+    for k, raw in enumerate(lines, start=1):
+        text = raw
+        if skip_comments and skip_comments in raw:
+            at = raw.index(skip_comments)
+            text = raw[:at]
+            if not text.strip():
+                comments.append(raw[at + len(skip_comments):].strip())
+        if not text.strip():
+            continue
+        if not rows and not _is_numeric_line(text, delimiter):
+            continue  # column titles above the data
+        row = _parse_numbers(text, path=p, lineno=k, delimiter=delimiter)
+        if len(row) < need:
+            raise ValueError(f"{p}, line {k}: {len(row)} column(s), but time_column={time_column} and "
+                             f"acc_column={acc_column} need {need} (line text: {raw.strip()!r})")
+        rows.append(row)
+        linenos.append(k)
+    if len(rows) < 2:
+        raise ValueError(f"{p}: found {len(rows)} data line(s); a record needs at least 2")
+    t = np.array([r[time_column] for r in rows])
+    acc = np.array([r[acc_column] for r in rows])
+    steps = np.diff(t)
+    if np.any(steps <= 0.0):
+        j = int(np.flatnonzero(steps <= 0.0)[0])
+        raise ValueError(f"{p}, line {linenos[j + 1]}: time {t[j + 1]!r} does not increase "
+                         f"(previous {t[j]!r} on line {linenos[j]})")
+    dt_typ = float(np.median(steps))
+    # 1e-6 relative catches any missing or repeated sample; the eps term absorbs float noise in long times.
+    tol = DT_RTOL * dt_typ + 16 * np.finfo(float).eps * float(np.max(np.abs(t)))
+    off = np.flatnonzero(np.abs(steps - dt_typ) > tol)
+    if off.size:
+        j = int(off[0])
+        raise ValueError(f"{p}, line {linenos[j + 1]}: time step {steps[j]!r} s differs from the record's "
+                         f"{dt_typ!r} s; rockdem needs a uniform dt (resample the file first)")
+    dt = (t[-1] - t[0]) / (t.size - 1)
+    return GroundMotion.from_samples(acc, dt=dt, units=unit, name=p.stem, source=p,
+                                     description=" | ".join(c for c in comments if c), start_time=float(t[0]))
+
+
+def read_single_column(path: str | os.PathLike[str], *, dt: float, units: str | AccelerationUnit,
+                       skip_header: int = 0) -> GroundMotion:
+    """Read a file with one acceleration value per line, sampled every ``dt`` seconds.
+
+    Args:
+        path: the file.
+        dt: time step [s], > 0.
+        units: "g", "m/s2" or "cm/s2".
+        skip_header: number of lines to skip at the top; blank and ``#`` lines are skipped anywhere.
+
+    Raises:
+        FileNotFoundError: missing file.
+        ValueError: bad dt, unparsable line, or a line with more than one value.
+    """
+    p, lines = _read_lines(path)
+    if dt is None or not np.isfinite(dt) or dt <= 0.0:
+        raise ValueError(f"{p}: dt must be a positive time step in seconds, got {dt!r}")
+    unit = _parse_units(units, f"{p}: units")
+    values: list[float] = []
+    for k in range(skip_header, len(lines)):
+        text = lines[k].split("#", 1)[0]
+        if not text.strip():
+            continue
+        row = _parse_numbers(text, path=p, lineno=k + 1)
+        if len(row) != 1:
+            raise ValueError(f"{p}, line {k + 1}: {len(row)} values where a single-column file has one "
+                             "(use read_columns for time/acceleration pairs)")
+        values.append(row[0])
+    if len(values) < 2:
+        raise ValueError(f"{p}: found {len(values)} value(s); a record needs at least 2")
+    return GroundMotion.from_samples(values, dt=dt, units=unit, name=p.stem, source=p)
+
+
+def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
+    if p.suffix.lower() == ".at2":
+        return RecordFormat.AT2
+    head = lines[:_HEADER_SCAN_LINES]
+    if any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head):
+        return RecordFormat.AT2
+    for line in lines:
+        text = line.split("#", 1)[0]
+        if text.strip() and _is_numeric_line(text, None):
+            count = len(_SPLIT_RE.split(text.strip()))
+            if count == 1:
+                return RecordFormat.SINGLE
+            if count == 2:
+                return RecordFormat.COLUMNS
+            raise ValueError(f"{p}: cannot tell the format from a first data line of {count} values; "
+                             "call read_columns (time_column=..., acc_column=...) or read_at2 directly")
+    raise ValueError(f"{p}: no numeric data line found")
+
+
+def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit | None = None,
+                dt: float | None = None, format: str | RecordFormat | None = None) -> GroundMotion:
+    """Read a ground-motion file of any supported format.
+
+    The format is ``format`` if given, else AT2 for a ``.AT2`` suffix or an NPTS/DT header line, else
+    two-column time/acceleration or single-column values, from the first data line.
+
+    Args:
+        path: the file.
+        units: "g", "m/s2" or "cm/s2"; optional for AT2 (header, else g), required otherwise.
+        dt: time step [s]; required for single-column files, overrides the header for AT2, and for
+            two-column files must agree with the time column.
+        format: "at2", "columns" or "single".
+    """
+    p, lines = _read_lines(path)
+    if format is not None and str(format).lower() not in {f.value for f in RecordFormat}:
+        raise ValueError(f"{p}: unknown format {format!r}; use 'at2', 'columns' or 'single' (or omit it)")
+    fmt = RecordFormat(str(format).lower()) if format is not None else _sniff_format(p, lines)
+    if fmt is RecordFormat.AT2:
+        return read_at2(p, units=units, dt=dt)
+    if units is None:
+        raise ValueError(f"{p}: the units of a {fmt.value} file are not known; pass units='g', 'm/s2' or "
+                         "'cm/s2'")
+    if fmt is RecordFormat.SINGLE:
+        if dt is None:
+            raise ValueError(f"{p} is a single-column file with no time information; pass dt=<time step "
+                             "in seconds>")
+        return read_single_column(p, dt=dt, units=units)
+    gm = read_columns(p, units=units)
+    if dt is not None and abs(gm.dt - dt) > DT_RTOL * dt:
+        raise ValueError(f"{p}: dt={dt!r} disagrees with the time column's {gm.dt!r} s; omit dt")
+    return gm
+
+
+def shared_record_path(name: str) -> Path:
+    """Path of a record in the project's shared ground-motion folder.
+
+    The folder is ``$ROCKDEM_DATA/ground-motions`` or ``$ROCKDEM_DATA`` itself if the environment
+    variable is set, else ``shared/data/ground-motions`` beside the repository root.
+
+    Raises:
+        FileNotFoundError: folder or file missing (the message lists the files available).
+    """
+    env = os.environ.get("ROCKDEM_DATA")
+    if env:
+        root = Path(env).expanduser()
+        folder = root / "ground-motions" if (root / "ground-motions").is_dir() else root
+    else:
+        folder = (Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "ground-motions").resolve()
+    if not folder.is_dir():
+        raise FileNotFoundError(f"ground-motion data folder not found: {folder}; set ROCKDEM_DATA to the "
+                                "folder holding the records (or to its parent data folder)")
+    path = folder / name
+    if not path.is_file():
+        have = ", ".join(sorted(f.name for f in folder.iterdir() if f.is_file() and f.suffix != ".md"))
+        raise FileNotFoundError(f"no record {name!r} in {folder}; available: {have}")
+    return path

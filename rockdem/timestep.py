@@ -1,0 +1,119 @@
+"""Stable timestep of the explicit scheme (DESIGN §2 "Timestep").
+
+Default rule ("bound"): safety x the critical step of the contacts tracked at the start, from a
+Gershgorin-type bound of the highest frequency with Belytschko's reduction for SP damping
+(:mod:`rockdem.kernels.bound`). During the run the bound is recomputed at every contact detection
+and the step is lowered if stiffer contacts form. A block with no contact at the start (in free
+fall) is bounded as if all its interface points touched.
+
+Rule "3dec": dt = 0.2 sqrt(m_min / k_max), k_max the stiffest sub-contact kn A of the model,
+followed by the same SP reduction with omega = sqrt(k_max / m_min), to compare runtimes with the
+paper's 3DEC figures.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .kernels.bound import contact_bound
+from .model import Model
+from .state import initial_state
+
+__all__ = ["TimestepInfo", "stable_timestep"]
+
+
+@dataclass(frozen=True)
+class TimestepInfo:
+    """Timestep figures.
+
+    Attributes:
+        dt: the initial timestep [s].
+        critical: the stable bound (safety 1) at the start [s]; a user dt above it is refused.
+        omega_max: bound of the highest circular frequency [rad/s].
+        sp_factor: reduction sqrt(1+xi^2) - xi for SP damping (1 without).
+        rule: "bound", "3dec" or "user".
+    """
+
+    dt: float
+    critical: float
+    omega_max: float
+    sp_factor: float
+    rule: str
+
+
+def _sp_factor(beta: float, omega: float) -> float:
+    xi = 0.5 * beta * omega
+    return math.sqrt(1.0 + xi * xi) - xi
+
+
+def _all_faces_bound(model: Model) -> tuple[float, float, float]:
+    """Critical step if every interface point of every free block touched a fixed partner."""
+    m = model.arrays
+    groups = np.unique(m.block_group)
+    coupling = 2.0 if int(np.count_nonzero(m.block_free)) > 1 else 1.0
+    face_of_point = np.repeat(np.arange(len(m.face_area)), np.diff(m.face_point_start))
+    best = (np.inf, 0.0, 1.0)
+    for b in np.flatnonzero(m.block_free):
+        g = m.block_group[b]
+        kn, ks = float(np.max(m.mat_kn[g, groups])), float(np.max(m.mat_ks[g, groups]))
+        beta = float(np.max(m.mat_beta[g, groups]))
+        sel = m.point_block == b
+        r, area, n = m.point_local[sel], m.point_area[sel], m.face_normal[face_of_point[sel]]
+        t1 = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+        t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+        t2 = np.cross(n, t1)
+
+        def flex(d: np.ndarray) -> np.ndarray:
+            return 1.0 / m.block_mass[b] + (np.cross(r, d) ** 2) @ (1.0 / m.block_inertia[b])
+
+        w = math.sqrt(coupling * float(np.sum(area * (kn * flex(n) + ks * (flex(t1) + flex(t2))))))
+        f = _sp_factor(beta, w)
+        if 2.0 / w * f < best[0]:
+            best = (2.0 / w * f, w, f)
+    return best
+
+
+def stable_timestep(model: Model, *, rule: str = "bound", safety: float = 0.9, dt: float | None = None) -> TimestepInfo:
+    """Timestep for ``model`` at its initial state.
+
+    Args:
+        rule: "bound" (default) or "3dec".
+        safety: fraction of the stable bound used (also when the step is lowered during a run).
+        dt: a user timestep [s]; refused if above the stable bound.
+
+    Raises:
+        ValueError: unknown rule, bad safety, or a user dt above the stable bound.
+    """
+    if rule not in ("bound", "3dec"):
+        raise ValueError(f"timestep rule must be 'bound' or '3dec', got {rule!r}")
+    if not (math.isfinite(safety) and 0.0 < safety <= 1.0):
+        raise ValueError(f"timestep safety must lie in (0, 1], got {safety!r}")
+    s, sc = initial_state(model)
+    out = np.empty(3)
+    contact_bound(model.arrays, s, sc, out)
+    critical, om, fac = float(out[0]), float(out[1]), float(out[2])
+    free_fall = _all_faces_bound(model)
+    if not math.isfinite(critical):
+        critical, om, fac = free_fall
+    if dt is not None:
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be a positive time step [s], got {dt!r}")
+        if dt > critical:
+            raise ValueError(
+                f"dt = {dt:.3e} s is above the stable bound {critical:.3e} s of this model "
+                f"(omega_max = {om:.4g} rad/s, SP reduction {fac:.4f}); use dt <= {critical:.3e} s "
+                "or leave dt unset for the automatic value"
+            )
+        return TimestepInfo(float(dt), critical, om, fac, "user")
+    if rule == "3dec":
+        m = model.arrays
+        free = m.block_free
+        m_min = float(np.min(m.block_mass[free]))
+        k_max = float(np.max(m.mat_kn)) * float(np.max(m.point_area[free[m.point_block]]))
+        w = math.sqrt(k_max / m_min)
+        f3 = _sp_factor(float(np.max(m.mat_beta)), w)
+        return TimestepInfo(0.2 * math.sqrt(m_min / k_max) * f3, critical, om, f3, "3dec")
+    return TimestepInfo(safety * critical, critical, om, fac, "bound")

@@ -1,0 +1,281 @@
+"""Tests of rockdem.records: readers of ground-motion files, units, and record processing.
+
+Reference values for the shared records come from shared/data/ground-motions/SOURCES.md (computed there
+from the file contents). Integration checks compare with closed forms and the trapezoid-rule error bound.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rockdem.records import (
+    STANDARD_GRAVITY,
+    GroundMotion,
+    read_at2,
+    read_columns,
+    read_record,
+    read_single_column,
+    shared_record_path,
+)
+
+NGA_HEADER = (
+    "PEER NGA STRONG MOTION DATABASE RECORD\n"
+    "Test event, 1/1/2000, Test station, 000\n"
+    "ACCELERATION TIME SERIES IN UNITS OF G\n"
+)
+
+
+def _write(tmp_path: Path, name: str, text: str) -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# ----------------------------------------------------------------------------------------- shared records
+
+# (file, npts, dt [s], PGA [g] to SOURCES.md's 4 decimals, t(PGA) [s] to its 2 decimals)
+SHARED = [
+    ("RSN6_IMPVALL.I_I-ELC180.AT2", 5372, 0.0100, 0.2808, 2.18),
+    ("elCentro.AT2", 1559, 0.0200, 0.3188, 2.02),
+    ("RSN77_SFERN_PUL164.AT2", 4172, 0.0100, 1.2190, 7.75),
+    ("Nahanni_1985_NS1-280.csv", 4113, 0.005, 1.0957, 9.16),
+    ("RSN285_ITALY_A-BAG270.AT2", 12712, 0.0029, 0.1897, 3.90),  # header dt .0029, 4 decimals
+    ("RSN289_ITALY_A-CTR270.AT2", 14672, 0.0024, 0.1364, 8.17),  # header dt .0024
+    ("RSN292_ITALY_A-STU270.AT2", 16392, 0.0024, 0.3205, 5.24),  # header dt .0024
+]
+
+
+@pytest.mark.parametrize(("name", "npts", "dt", "pga_g", "t_pga"), SHARED, ids=[s[0] for s in SHARED])
+def test_shared_records_match_sources(name: str, npts: int, dt: float, pga_g: float, t_pga: float) -> None:
+    """Each shared file reads with the npts, dt, PGA and time of PGA listed in SOURCES.md."""
+    gm = read_record(shared_record_path(name), units="g" if name.endswith(".csv") else None)
+    assert gm.npts == npts
+    assert gm.units_in == "g"
+    # Header dt is exact; the CSV's dt is the mean step of a printed time column (float noise ~1e-15).
+    assert gm.dt == pytest.approx(dt, rel=1e-9)
+    assert gm.duration == pytest.approx((npts - 1) * dt, rel=1e-9)
+    # SOURCES.md rounds PGA to 4 decimals: half a unit of the last digit.
+    assert abs(gm.pga_g - pga_g) <= 0.5e-4
+    assert gm.pga == pytest.approx(gm.pga_g * STANDARD_GRAVITY, rel=1e-12)
+    # t(PGA) is rounded to 2 decimals; the sample grid itself adds no error (t = i * dt).
+    assert abs(gm.pga_time - t_pga) <= 0.005 + 1e-9
+
+
+def test_header_text_and_units_are_kept() -> None:
+    """The AT2 description comes from the header, in the NGA and the Peknold variants."""
+    assert "El Centro Array #9" in read_at2(shared_record_path("RSN6_IMPVALL.I_I-ELC180.AT2")).description
+    assert "Peknold" in read_at2(shared_record_path("elCentro.AT2")).description
+
+
+def test_shared_record_path_env_and_missing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """ROCKDEM_DATA redirects the lookup (folder or its parent); missing names list what exists."""
+    folder = tmp_path / "ground-motions"
+    folder.mkdir()
+    (folder / "x.AT2").write_text("")
+    monkeypatch.setenv("ROCKDEM_DATA", str(tmp_path))
+    assert shared_record_path("x.AT2") == folder / "x.AT2"
+    monkeypatch.setenv("ROCKDEM_DATA", str(folder))
+    assert shared_record_path("x.AT2") == folder / "x.AT2"
+    with pytest.raises(FileNotFoundError, match=r"available: x\.AT2"):
+        shared_record_path("nope.AT2")
+    monkeypatch.setenv("ROCKDEM_DATA", str(tmp_path / "absent"))
+    with pytest.raises(FileNotFoundError, match="ROCKDEM_DATA"):
+        shared_record_path("x.AT2")
+
+
+# ------------------------------------------------------------------------------------------- AT2 parsing
+
+def test_stuck_negative_values_are_split(tmp_path: Path) -> None:
+    """A sign not preceded by E/e/D starts a new number: '1.234-5.678', '.1E-02-.2E-03', D exponents."""
+    body = "1.234-5.678  .1E-02-.2E-03\n-1.0D-01 2.5d+00-3\n"
+    path = _write(tmp_path, "stuck.AT2", NGA_HEADER + "NPTS=  7, DT=   .0100 SEC,\n" + body)
+    gm = read_at2(path)
+    expected = np.array([1.234, -5.678, 0.1e-2, -0.2e-3, -0.1, 2.5, -3.0]) * STANDARD_GRAVITY
+    np.testing.assert_allclose(gm.acceleration, expected, rtol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "npts_line",
+    [
+        "NPTS=  3, DT=   .0100 SEC,",  # NGA-West2
+        "NPTS=  3, DT= .01000 SEC",  # Peknold
+        "NPTS= 3 DT= 0.01",  # no comma, no SEC
+        "npts=3, dt=1.0e-2 sec",  # lowercase, E-format dt
+        "     3    0.01000   NPTS, DT",  # older PEER header
+    ],
+)
+def test_at2_header_variants(tmp_path: Path, npts_line: str) -> None:
+    """All tolerated NPTS/DT spellings give NPTS=3 and dt=0.01 s."""
+    path = _write(tmp_path, "h.AT2", NGA_HEADER + npts_line + "\n  .1  -.2\n .3\n")
+    gm = read_at2(path)
+    assert gm.npts == 3 and gm.dt == pytest.approx(0.01, rel=1e-15)
+
+
+def test_at2_header_units_and_conflict(tmp_path: Path) -> None:
+    """Header units are honoured (cm/s/s -> x0.01); an explicit contradicting unit is refused."""
+    text = NGA_HEADER.replace("UNITS OF G", "UNITS OF CM/S/S") + "NPTS= 2, DT= .01 SEC\n 100. -50.\n"
+    path = _write(tmp_path, "cm.AT2", text)
+    np.testing.assert_allclose(read_at2(path).acceleration, [1.0, -0.5], rtol=1e-15)
+    assert read_at2(path).units_in == "cm/s2"
+    with pytest.raises(ValueError, match="contradicts the header"):
+        read_at2(path, units="g")
+
+
+def test_at2_dt_override(tmp_path: Path) -> None:
+    """dt= overrides a header dt rounded to 4 decimals (the Italian records' case)."""
+    path = _write(tmp_path, "d.AT2", NGA_HEADER + "NPTS= 2, DT= .0029 SEC\n .1 .2\n")
+    assert read_at2(path, dt=0.00293).dt == 0.00293
+
+
+def test_malformed_token_names_line(tmp_path: Path) -> None:
+    """An unparsable token on file line 7 is reported with the file, 'line 7' and the text."""
+    lines = ["  .1  .2  .3  .4  .5"] * 3
+    lines[2] = "  .1  .2  x.3  .4  .5"  # header is 4 lines, so this is line 7
+    path = _write(tmp_path, "bad.AT2", NGA_HEADER + "NPTS= 15, DT= .01\n" + "\n".join(lines) + "\n")
+    with pytest.raises(ValueError, match=r"bad\.AT2, line 7: cannot read 'x\.3'"):
+        read_at2(path)
+
+
+def test_nan_in_file_is_rejected(tmp_path: Path) -> None:
+    """NaN is not a number a record may contain: the line is named."""
+    path = _write(tmp_path, "nan.AT2", NGA_HEADER + "NPTS= 3, DT= .01\n .1 NaN .3\n")
+    with pytest.raises(ValueError, match="line 5: cannot read 'NaN'"):
+        read_at2(path)
+
+
+def test_npts_mismatch(tmp_path: Path) -> None:
+    """A value count different from NPTS is an error stating both numbers."""
+    path = _write(tmp_path, "short.AT2", NGA_HEADER + "NPTS= 6, DT= .01\n .1 .2 .3\n .4 .5\n")
+    with pytest.raises(ValueError, match=r"short\.AT2.*NPTS=6 but 5 values"):
+        read_at2(path)
+
+
+def test_missing_empty_and_headerless(tmp_path: Path) -> None:
+    """File not found, empty file and a .AT2 without NPTS line give clear errors."""
+    with pytest.raises(FileNotFoundError, match="not found"):
+        read_record(tmp_path / "absent.AT2")
+    with pytest.raises(ValueError, match="empty"):
+        read_record(_write(tmp_path, "empty.AT2", "\n  \n"))
+    with pytest.raises(ValueError, match="NPTS"):
+        read_at2(_write(tmp_path, "nohead.AT2", ".1 .2\n"))
+
+
+# --------------------------------------------------------------------------------------- column formats
+
+def test_columns_non_uniform_step_names_line(tmp_path: Path) -> None:
+    """A time column whose spacing breaks (a missing sample) is refused, naming the line."""
+    rows = [f"{0.01 * i!r},{0.1 * i!r}" for i in range(10) if i != 6]  # sample 6 missing
+    path = _write(tmp_path, "gap.csv", "# comment\ntime,accel\n" + "\n".join(rows) + "\n")
+    # line 1 comment, line 2 titles, data from line 3: sample 7 sits on line 3 + 6 = 9.
+    with pytest.raises(ValueError, match=r"gap\.csv, line 9: time step"):
+        read_columns(path, units="g")
+
+
+def test_columns_titles_comments_and_float_noise(tmp_path: Path) -> None:
+    """Titles at the top and '#' lines anywhere are skipped; times with float noise are uniform."""
+    times = np.cumsum(np.full(50, 0.005)) - 0.005  # accumulated sum: noise ~1e-17 relative
+    rows = [f"{t:.17g} {a:.17g}" for t, a in zip(times, np.sin(times))]
+    rows.insert(20, "# a comment in the middle")
+    path = _write(tmp_path, "cols.txt", "Time  Accel\n" + "\n".join(rows) + "\n")
+    gm = read_columns(path, units="m/s2")
+    assert gm.npts == 50 and gm.dt == pytest.approx(0.005, rel=1e-12)
+    np.testing.assert_allclose(gm.acceleration, np.sin(times), rtol=1e-15)
+    bad = _write(tmp_path, "late.txt", "0 1\n0.1 2\nTime Accel\n0.2 3\n")
+    with pytest.raises(ValueError, match="line 3"):  # titles are only allowed above the data
+        read_columns(bad, units="g")
+
+
+def test_single_column_and_autodetect(tmp_path: Path) -> None:
+    """One value per line needs dt (the message says so); with dt it reads; bad dt is refused."""
+    path = _write(tmp_path, "one.txt", "0.1\n-0.2\n0.3\n")
+    with pytest.raises(ValueError, match="pass dt="):
+        read_record(path, units="g")
+    gm = read_record(path, units="g", dt=0.02)
+    assert gm.npts == 3 and gm.dt == 0.02
+    assert read_single_column(path, dt=0.02, units="g").pga_g == pytest.approx(0.3, rel=1e-15)
+    for dt in (0.0, -0.01, float("nan")):
+        with pytest.raises(ValueError, match="dt must be a positive"):
+            read_single_column(path, dt=dt, units="g")
+    with pytest.raises(ValueError, match="units"):
+        read_record(path, dt=0.02)
+
+
+def test_units_give_same_si_values(tmp_path: Path) -> None:
+    """The same record written in g and in cm/s^2 gives the same m/s^2 samples (1 g = 980.665 cm/s^2)."""
+    rng = np.random.default_rng(1)
+    a_g = rng.normal(0.0, 0.2, 200)
+    t = 0.01 * np.arange(200)
+    p_g = _write(tmp_path, "g.csv", "\n".join(f"{ti:.17g},{a:.17g}" for ti, a in zip(t, a_g)))
+    p_cm = _write(tmp_path, "cm.csv", "\n".join(f"{ti:.17g},{a * 980.665:.17g}" for ti, a in zip(t, a_g)))
+    gm_g, gm_cm = read_record(p_g, units="g"), read_record(p_cm, units="cm/s2")
+    # Only rounding of the printed and converted floats differs: a few ulps.
+    np.testing.assert_allclose(gm_cm.acceleration, gm_g.acceleration, rtol=1e-13)
+    assert gm_g.pga == pytest.approx(np.max(np.abs(a_g)) * STANDARD_GRAVITY, rel=1e-15)
+
+
+# ------------------------------------------------------------------------------------------- processing
+
+def test_scaling_and_tail() -> None:
+    """A factor 2 doubles the PGA; scaled_to_pga hits its target; a tail appends zeros at the same dt."""
+    gm = GroundMotion(np.array([0.0, 1.0, -3.0, 2.0]), 0.01, vertical=np.array([0.0, 0.5, 0.0, 0.0]))
+    assert gm.scaled(2.0).pga == pytest.approx(2.0 * gm.pga, rel=1e-15)
+    target = gm.scaled_to_pga(9.0)
+    assert target.pga == pytest.approx(9.0, rel=1e-15)
+    assert target.vertical is not None and target.vertical[1] == pytest.approx(1.5)  # V/H ratio kept
+    tail = gm.with_tail(0.05)
+    assert tail.npts == 9 and tail.dt == gm.dt and np.all(tail.acceleration[4:] == 0.0)
+
+
+def test_constant_acceleration_integrates_exactly() -> None:
+    """Constant a over T: v(T) = a T and d(T) = a T^2 / 2 (Newton). The trapezoid rule is exact for
+    constant and linear integrands, so only roundoff remains (rtol 1e-12)."""
+    a, dt, n = 0.7, 0.01, 1001
+    gm = GroundMotion(np.full(n, a), dt)
+    big_t = gm.duration
+    assert gm.velocity()[-1] == pytest.approx(a * big_t, rel=1e-12)
+    assert gm.displacement()[-1] == pytest.approx(0.5 * a * big_t**2, rel=1e-12)
+    assert gm.velocity()[0] == 0.0 and gm.displacement()[0] == 0.0
+
+
+def test_velocity_of_cosine_within_trapezoid_bound() -> None:
+    """a = cos(w t) gives v = sin(w t)/w. Trapezoid error bound: T dt^2 max|a''| / 12 = T dt^2 w^2 / 12."""
+    w, dt, n = 2.0 * np.pi * 1.5, 0.005, 2001
+    gm = GroundMotion(np.cos(w * dt * np.arange(n)), dt)
+    bound = gm.duration * dt**2 * w**2 / 12.0
+    assert np.max(np.abs(gm.velocity() - np.sin(w * gm.time) / w)) <= bound
+
+
+def test_baseline_correction_removes_offset() -> None:
+    """A sine over whole periods plus a constant offset a0 ends with v = a0 T; after the order-1
+    correction the end velocity is within the trapezoid error bound T dt^2 A w^2 / 12 of zero."""
+    amp, w, a0, dt = 1.0, 2.0 * np.pi, 0.05, 0.01
+    t = dt * np.arange(2001)  # 20 s = 20 whole periods
+    gm = GroundMotion(amp * np.sin(w * t) + a0, dt)
+    assert gm.velocity()[-1] == pytest.approx(a0 * 20.0, rel=1e-9)
+    corrected = gm.baseline_corrected(order=1)
+    assert abs(corrected.velocity()[-1]) <= 20.0 * dt**2 * amp * w**2 / 12.0
+    # A pure constant offset is removed exactly (a linear velocity is fitted exactly): roundoff only.
+    flat = GroundMotion(np.full(500, a0), dt).baseline_corrected(order=2)
+    assert np.max(np.abs(flat.acceleration)) <= 1e-12
+
+
+def test_direction_vertical_and_resampling() -> None:
+    """vector_acceleration = a * unit(direction) + vertical on z; horizontal-only directions;
+    linear resampling reproduces a linear record exactly."""
+    acc = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    gm = GroundMotion(acc, 0.1, direction=(3.0, 4.0, 0.0), vertical=-0.5 * acc)
+    expected = np.column_stack([0.6 * acc, 0.8 * acc, -0.5 * acc])
+    np.testing.assert_allclose(gm.vector_acceleration(), expected, rtol=1e-15)
+    np.testing.assert_allclose(gm.vector_velocity()[:, 2], -0.5 * gm.velocity(), rtol=1e-15)
+    with pytest.raises(ValueError, match="horizontal"):
+        gm.with_direction((0.0, 0.0, 1.0))
+    fine = gm.resampled(0.025)
+    assert fine.npts == 17
+    np.testing.assert_allclose(fine.acceleration, fine.time / 0.1, rtol=1e-12, atol=1e-12)
+    with pytest.raises(ValueError, match="non-finite"):
+        GroundMotion(np.array([0.0, np.nan]), 0.01)
+    with pytest.raises(ValueError, match="dt must be a positive"):
+        GroundMotion(acc, 0.0)
