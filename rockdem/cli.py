@@ -10,6 +10,9 @@ import sys
 _COMMAND_MODULES = (
     "rockdem.run_cli",
     "rockdem.advisor",
+    "rockdem.plots",
+    "rockdem.animate",
+    "rockdem.vtk_export",
 )
 
 

@@ -111,6 +111,7 @@ class _Block:
     velocity: NDArray[np.float64]
     angular_velocity: NDArray[np.float64]
     tilt: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
+    reference: Polyhedron | None = None
 
 
 @dataclass(frozen=True)
@@ -126,6 +127,8 @@ class Model:
         quaternion0: (nb, 4) initial orientations (body principal frame -> world).
         quaternion_ref: (nb, 4) reference orientations from which rotations are measured: the
             initial ones before any :meth:`ModelBuilder.tilt`.
+        position_ref: (nb, 3) reference centroids (before any tilt) [m]; monitor points are
+            given, and their displacements measured, in this reference configuration.
         velocity0: (nb, 3) initial velocities [m/s].
         omega0: (nb, 3) initial angular velocities, body frame [rad/s].
         damping: the damping options.
@@ -140,6 +143,7 @@ class Model:
     position0: NDArray[np.float64]
     quaternion0: NDArray[np.float64]
     quaternion_ref: NDArray[np.float64]
+    position_ref: NDArray[np.float64]
     velocity0: NDArray[np.float64]
     omega0: NDArray[np.float64]
     damping: Damping
@@ -262,12 +266,19 @@ class ModelBuilder:
         """Current geometry of block ``i`` (id or name)."""
         return self._blocks[self._index(i)].poly
 
-    def transform_block(self, i: int | str, rotation: ArrayLike, about: ArrayLike = (0.0, 0.0, 0.0)) -> None:
-        """Rotate block ``i`` rigidly by matrix ``rotation`` about point ``about`` [m]."""
+    def transform_block(
+        self,
+        i: int | str,
+        rotation: ArrayLike = np.eye(3),
+        about: ArrayLike = (0.0, 0.0, 0.0),
+        translation: ArrayLike = (0.0, 0.0, 0.0),
+    ) -> None:
+        """Move block ``i`` rigidly: rotate by matrix ``rotation`` about point ``about``, then
+        translate by ``translation`` [m]."""
         r = np.asarray(rotation, dtype=float)
         a = np.asarray(about, dtype=float)
         blk = self._blocks[self._index(i)]
-        blk.poly = blk.poly.transformed(r, a - r @ a)
+        blk.poly = blk.poly.transformed(r, a - r @ a + np.asarray(translation, dtype=float))
 
     def tilt(self, i: int | str, fraction: float, *, direction: ArrayLike = (1.0, 0.0, 0.0)) -> float:
         """Tilt block ``i`` about its base edge on the ``direction`` side to ``fraction`` of its
@@ -296,6 +307,8 @@ class ModelBuilder:
         theta = fraction * eta
         axis = np.cross(up, d)
         r = axis_angle_matrix(axis, theta)
+        if blk.reference is None:
+            blk.reference = blk.poly
         self.transform_block(i, r, about=pivot)
         blk.tilt = r @ blk.tilt
         return theta
@@ -387,6 +400,7 @@ class ModelBuilder:
         pos0 = np.zeros((nb, 3))
         quat0 = np.zeros((nb, 4))
         quat_ref = np.zeros((nb, 4))
+        pos_ref = np.zeros((nb, 3))
         vel0 = np.zeros((nb, 3))
         om0 = np.zeros((nb, 3))
         radius = np.zeros(nb)
@@ -405,6 +419,7 @@ class ModelBuilder:
             mass[b], inertia[b], pos0[b] = mp.mass, evals, mp.centroid
             quat0[b] = matrix_to_quat(rot)
             quat_ref[b] = matrix_to_quat(blk.tilt.T @ rot)
+            pos_ref[b] = mp.centroid if blk.reference is None else mass_properties(blk.reference, blk.density).centroid
             free = blk.driven is False
             vel0[b] = blk.velocity if free else 0.0
             om0[b] = rot.T @ blk.angular_velocity if free else 0.0
@@ -501,6 +516,7 @@ class ModelBuilder:
             position0=pos0,
             quaternion0=quat0,
             quaternion_ref=quat_ref,
+            position_ref=pos_ref,
             velocity0=vel0,
             omega0=om0,
             damping=damping,

@@ -8,7 +8,7 @@ Variables (dims; units in each variable's ``units`` attribute):
   block_rotation (time, block, xyz) [rad]      rotation vector of R(t) R_ref^T (world); R_ref is the
                                                orientation before any initial tilt
   rocking_angle (time, block) [rad]            block_rotation . rocking_axis
-  monitor_displacement (time, monitor, xyz) [m]
+  monitor_displacement (time, monitor, xyz) [m] from the monitor's reference (untilted) position
   contacts_active / _bonded / _failed_tension / _failed_shear (time) [-]  sub-contact counts
   base_reaction (time, xyz) [N]                force of the driven blocks on the free blocks
   energy_* and work_* (time) [J], energy_balance_error (time) [J], energy_balance_error_relative
@@ -55,6 +55,7 @@ def build_dataset(
     rref = quats_to_matrices(model.quaternion_ref)
     rel = np.einsum("tbij,bkj->tbik", r, r0)  # rotation since t = 0 (moves monitor points)
     rotvec = rotation_vector(np.einsum("tbij,bkj->tbik", r, rref))  # since the untilted reference
+    del rel
     axis = model.rocking_axis
     ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": np.arange(model.block_count)})
     xyz = ("time", "block", "xyz")
@@ -67,10 +68,11 @@ def build_dataset(
     ds["rocking_angle"] = (("time", "block"), rotvec @ axis, {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)
     mdisp = np.zeros((len(t), len(names), 3))
+    rel_ref = np.einsum("tbij,bkj->tbik", r, rref)
     for k, name in enumerate(names):
-        b, p0 = monitors[name]
-        arm0 = p0 - model.position0[b]
-        mdisp[:, k] = np.einsum("tij,j->ti", rel[:, b], arm0) + rec.position[:, b] - p0
+        b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
+        arm = p_ref - model.position_ref[b]
+        mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + rec.position[:, b] - p_ref
     ds = ds.assign_coords(monitor=np.array(names, dtype=object) if names else np.zeros(0, dtype=object))
     ds["monitor_displacement"] = (("time", "monitor", "xyz"), mdisp, {"units": "m"})
     for k, name in enumerate(COUNT_NAMES):

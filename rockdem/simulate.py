@@ -18,13 +18,14 @@ from .kernels.layout import Records, new_records
 from .kernels.step import advance
 from .model import Model
 from .results import build_dataset
+from .snapshots import ContactSnapshots
 from .state import initial_state
 from .timestep import TimestepInfo, stable_timestep
 
 __all__ = ["simulate", "Monitor"]
 
 Monitor = tuple[int | str, Sequence[float]]
-"""A monitor point: (block id or name, world coordinates at t = 0 [m])."""
+"""A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
 
 _MAX_RECORD_BYTES = 2 * 1024**3
 
@@ -39,6 +40,7 @@ def simulate(
     record_interval: float = 0.002,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
+    contact_interval: float | None = None,
 ) -> xr.Dataset:
     """Run ``model`` for ``duration`` seconds and return the recorded histories.
 
@@ -50,8 +52,11 @@ def simulate(
         safety: fraction of the stable bound for the automatic timestep.
         record_interval: time between recorded frames [s] (rounded to whole steps).
         monitors: named points whose world displacement is recorded, e.g.
-            ``{"top": ("wall", (0.1, 0.0, 2.0))}`` (block, world position at t = 0 [m]).
+            ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
+            configuration (before any initial tilt); displacements are measured from there.
         progress: show a progress bar; default: only for runs expected to last over 2 s.
+        contact_interval: time between sub-contact snapshots [s] (see :mod:`rockdem.snapshots`);
+            default None: none recorded.
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
@@ -61,6 +66,7 @@ def simulate(
     if not (math.isfinite(record_interval) and record_interval > 0):
         raise ValueError(f"record_interval must be a positive time [s], got {record_interval!r}")
     mon = _check_monitors(model, monitors or {})
+    snaps = ContactSnapshots(model, contact_interval)
     info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, dt=dt)
     frames = int(math.floor(duration / record_interval + 1e-9)) + 1
     need = frames * model.block_count * 13 * 8
@@ -73,6 +79,7 @@ def simulate(
     state, scratch = initial_state(model)
     state.clock[1] = state.clock[2] = state.clock[4] = info.dt
     state.clock[3] = safety
+    snaps.take(state)
     rec = new_records(frames, model.block_count)
     m = model.arrays
     frame = 0
@@ -82,10 +89,11 @@ def simulate(
     try:
         while state.clock[0] < duration - 1e-12 * duration and frame <= frames:
             t_before = float(state.clock[0])
-            stop = min(duration, t_before + chunk)
+            stop = snaps.clip(min(duration, t_before + chunk))
             t0 = _time.perf_counter()
             frame = advance(m, state, scratch, stop, record_interval, rec, frame)
             elapsed = _time.perf_counter() - t0
+            snaps.take(state)
             chunk = min(chunk * 4.0, max(state.clock[1], chunk * 0.25 / max(elapsed, 1e-6)))
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
                 from tqdm.auto import tqdm
@@ -100,7 +108,7 @@ def simulate(
             bar.close()
     runtime = _time.perf_counter() - wall0
     rec = Records(*(a[:frame] for a in rec))
-    return build_dataset(
+    ds = build_dataset(
         model,
         rec,
         monitors=mon,
@@ -118,6 +126,7 @@ def simulate(
             "interrupted": int(interrupted),
         },
     )
+    return snaps.attach(ds)
 
 
 def _check_monitors(model: Model, monitors: Mapping[str, Monitor]) -> dict[str, tuple[int, np.ndarray]]:

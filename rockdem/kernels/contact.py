@@ -4,7 +4,9 @@ Per sub-contact of area A with normal overlap u_n (compression > 0):
   F_n = kn A u_n, tension only while bonded and down to -ft A (else the bond fails in tension);
   |F_s| <= c A + F_n tan(phi) while bonded, c_r A + F_n tan(phi_r) after failure (else slip, and a
   bonded point fails in shear, dropping to its residual strength);
-  SP dashpots beta kn A du_n/dt and beta ks A du_s/dt act on active sub-contacts.
+  SP dashpots beta kn A du_n/dt and beta ks A du_s/dt act on active sub-contacts; as Rayleigh
+  damping is proportional to the tangent stiffness, the shear dashpot is off while a point slips
+  (and both are off while it is open).
 """
 
 from __future__ import annotations

@@ -132,6 +132,10 @@ class Scratch(NamedTuple):
     body_acc: np.ndarray  # (3,) [m/s^2]
     omega_world: np.ndarray  # (nb, 3) [rad/s]
     point_tmp: np.ndarray  # (4,)
+    dashpot_force: np.ndarray  # (np, 3) [N] SP dashpot force on the point's block, per tracked slot
+    dashpot_point: np.ndarray  # (np, 3) [m] contact point of that dashpot, world
+    velocity_mid: np.ndarray  # (nb, 3) [m/s] step mid-point velocity
+    omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
 
 
 class Records(NamedTuple):

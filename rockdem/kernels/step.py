@@ -93,7 +93,6 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
     active = 0
     e_fric = 0.0
     e_bond = 0.0
-    p_sp = 0.0
     sc.sums[2] = 0.0
     sc.sums[3] = 0.0
     sc.sums[4] = 0.0
@@ -112,6 +111,9 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
         ksa = m.mat_ks[go, gt] * area
         un = -gap
         sh = s.point_shear[p]
+        sc.dashpot_force[k, 0] = 0.0
+        sc.dashpot_force[k, 1] = 0.0
+        sc.dashpot_force[k, 2] = 0.0
         if tmp[3] > m.edge_tol or (un <= 0.0 and not s.point_bonded[p]):
             # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
             if s.point_bonded[p]:
@@ -167,7 +169,8 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
             fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
         else:
             fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
-        if trial > fmax:
+        slipping = trial > fmax
+        if slipping:
             e_fric += slip_dissipation(trial, fmax, ksa)
             if bonded:
                 # Shear failure: drop to the residual strength; the released energy is the bond's.
@@ -187,12 +190,20 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
         elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
         active += 1
         # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
+        # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
         beta = m.mat_beta[go, gt]
         fdn = -beta * kna * vn
-        p_sp += beta * (kna * vn * vn + ksa * (vs0 * vs0 + vs1 * vs1 + vs2 * vs2))
-        f[0] = (fn + fdn) * n0 + sh[0] - beta * ksa * vs0
-        f[1] = (fn + fdn) * n1 + sh[1] - beta * ksa * vs1
-        f[2] = (fn + fdn) * n2 + sh[2] - beta * ksa * vs2
+        bs = 0.0 if slipping else beta * ksa
+        fd = sc.dashpot_force[k]
+        fd[0] = fdn * n0 - bs * vs0
+        fd[1] = fdn * n1 - bs * vs1
+        fd[2] = fdn * n2 - bs * vs2
+        sc.dashpot_point[k, 0] = c0
+        sc.dashpot_point[k, 1] = c1
+        sc.dashpot_point[k, 2] = c2
+        f[0] = fn * n0 + sh[0] + fd[0]
+        f[1] = fn * n1 + sh[1] + fd[1]
+        f[2] = fn * n2 + sh[2] + fd[2]
         for i in range(3):
             sc.force[o, i] += f[i]
             sc.force[tb, i] -= f[i]
@@ -208,7 +219,6 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
     sc.sums[1] = active
     s.energy[E_FRICTION] += e_fric
     s.energy[E_BOND] += e_bond
-    s.energy[E_DAMPING_STIFFNESS] += p_sp * dt
 
 
 @njit(cache=True)
@@ -287,11 +297,14 @@ def integrate_velocities(
                 s.omega[b, i] = 0.0
                 va[i] = vd[i]
                 wa[i] = 0.0
+        for i in range(3):
+            sc.velocity_mid[b, i] = va[i]
+            sc.omega_mid[b, i] = r[i, 0] * wa[0] + r[i, 1] * wa[1] + r[i, 2] * wa[2]
         if frame >= 0:
             for i in range(3):
                 rec.position[frame, b, i] = s.position[b, i]
                 rec.velocity[frame, b, i] = va[i]
-                rec.omega[frame, b, i] = r[i, 0] * wa[0] + r[i, 1] * wa[1] + r[i, 2] * wa[2]
+                rec.omega[frame, b, i] = sc.omega_mid[b, i]
             for i in range(4):
                 rec.quaternion[frame, b, i] = s.quaternion[b, i]
     s.energy[E_DAMPING_MASS] += e_mp
@@ -321,6 +334,31 @@ def integrate_velocities(
         rec.counts[frame, 3] = fshear
         for i in range(3):
             rec.reaction[frame, i] = sc.sums[2 + i]
+
+
+@njit(cache=True)
+def dashpot_work(m: ModelArrays, s: State, sc: Scratch, h: float) -> None:
+    """Energy dissipated by the SP dashpots over the step: -F_d . v_rel(mid-step) h, the same
+    velocities that change the kinetic energy, so that the energy balance closes."""
+    e = 0.0
+    for k in range(s.track_count[0]):
+        fd = sc.dashpot_force[k]
+        if fd[0] == 0.0 and fd[1] == 0.0 and fd[2] == 0.0:
+            continue
+        p = s.track[k]
+        o = m.point_block[p]
+        tb = s.point_partner[p]
+        c = sc.dashpot_point[k]
+        vr = np.empty(3)
+        ro = c - s.position[o]
+        rt = c - s.position[tb]
+        wo = sc.omega_mid[o]
+        wt = sc.omega_mid[tb]
+        vr[0] = sc.velocity_mid[o, 0] + wo[1] * ro[2] - wo[2] * ro[1] - sc.velocity_mid[tb, 0] - wt[1] * rt[2] + wt[2] * rt[1]
+        vr[1] = sc.velocity_mid[o, 1] + wo[2] * ro[0] - wo[0] * ro[2] - sc.velocity_mid[tb, 1] - wt[2] * rt[0] + wt[0] * rt[2]
+        vr[2] = sc.velocity_mid[o, 2] + wo[0] * ro[1] - wo[1] * ro[0] - sc.velocity_mid[tb, 2] - wt[0] * rt[1] + wt[1] * rt[0]
+        e -= (fd[0] * vr[0] + fd[1] * vr[1] + fd[2] * vr[2]) * h
+    s.energy[E_DAMPING_STIFFNESS] += e
 
 
 @njit(cache=True)
@@ -369,6 +407,7 @@ def advance(
         if frame < rec.time.shape[0] and t >= frame * record_interval - 1e-9 * dt:
             now = frame
         integrate_velocities(m, s, sc, t, h, rec, now)
+        dashpot_work(m, s, sc, h)
         if now >= 0:
             frame += 1
         integrate_positions(m, s, dt)

@@ -1,0 +1,339 @@
+"""TOML case files: validated one-to-one onto the builders and ``simulate()`` options.
+
+A case has the tables ``[run]``, ``[damping]``, ``[specimen]`` (with ``type``), ``[loading]`` and
+``[output]``. Every key is checked: an unknown key or a wrong type is an error naming the table,
+the key and the accepted keys. Specimen types register themselves in :data:`SPECIMENS`; loadings
+in :data:`LOADINGS`. Units: SI, angles in degrees where the key says ``_deg``.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .materials import JointMaterial
+from .model import Damping, Model, ModelBuilder
+from .simulate import Monitor
+
+__all__ = [
+    "Table",
+    "RunOptions",
+    "Case",
+    "SPECIMENS",
+    "LOADINGS",
+    "load_case",
+    "parse_case",
+    "build_case",
+    "example_names",
+    "example_case",
+    "apply_overrides",
+]
+
+
+class Table:
+    """A TOML table read key by key with type checks; :meth:`finish` rejects unused keys."""
+
+    def __init__(self, data: Mapping[str, Any] | None, where: str) -> None:
+        if data is not None and not isinstance(data, Mapping):
+            raise ValueError(f"[{where}] must be a table, got {type(data).__name__}")
+        self.data = dict(data or {})
+        self.where = where
+        self.used: set[str] = set()
+
+    def _get(self, key: str, default: Any) -> Any:
+        self.used.add(key)
+        return self.data.get(key, default)
+
+    def number(self, key: str, default: float | None = None, *, positive: bool = False, min_: float | None = None) -> float:
+        """A real number; ``default=None`` makes it required."""
+        v = self._get(key, default)
+        if v is None:
+            raise ValueError(f"[{self.where}] {key} is required (a number)")
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise ValueError(f"[{self.where}] {key} must be a finite number, got {v!r}")
+        if positive and not v > 0:
+            raise ValueError(f"[{self.where}] {key} must be positive, got {v!r}")
+        if min_ is not None and v < min_:
+            raise ValueError(f"[{self.where}] {key} must be >= {min_}, got {v!r}")
+        return float(v)
+
+    def optional_number(self, key: str, *, positive: bool = False) -> float | None:
+        """A number or None when absent."""
+        if key not in self.data:
+            self.used.add(key)
+            return None
+        return self.number(key, positive=positive)
+
+    def integer(self, key: str, default: int | None = None, *, min_: int = 0) -> int:
+        v = self._get(key, default)
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise ValueError(f"[{self.where}] {key} must be an integer, got {v!r}")
+        if v < min_:
+            raise ValueError(f"[{self.where}] {key} must be >= {min_}, got {v!r}")
+        return v
+
+    def boolean(self, key: str, default: bool) -> bool:
+        v = self._get(key, default)
+        if not isinstance(v, bool):
+            raise ValueError(f"[{self.where}] {key} must be true or false, got {v!r}")
+        return v
+
+    def string(self, key: str, default: str | None = None, *, choices: tuple[str, ...] | None = None) -> str:
+        v = self._get(key, default)
+        if v is None:
+            raise ValueError(f"[{self.where}] {key} is required (a string)")
+        if not isinstance(v, str):
+            raise ValueError(f"[{self.where}] {key} must be a string, got {v!r}")
+        if choices is not None and v not in choices:
+            raise ValueError(f"[{self.where}] {key} must be one of {list(choices)}, got {v!r}")
+        return v
+
+    def vector(self, key: str, default: tuple[float, ...] | None = None, *, size: int = 3) -> np.ndarray:
+        v = self._get(key, default)
+        if v is None:
+            raise ValueError(f"[{self.where}] {key} is required (a list of {size} numbers)")
+        try:
+            arr = np.asarray(v, dtype=float).reshape(size)
+        except (TypeError, ValueError):
+            raise ValueError(f"[{self.where}] {key} must be a list of {size} numbers, got {v!r}") from None
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"[{self.where}] {key} must be finite, got {v!r}")
+        return arr
+
+    def sub(self, key: str) -> "Table":
+        """A nested table (empty when absent)."""
+        return Table(self._get(key, {}), f"{self.where}.{key}")
+
+    def raw(self, key: str, default: Any = None) -> Any:
+        return self._get(key, default)
+
+    def finish(self) -> None:
+        """Raise for any key that was not read."""
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise ValueError(
+                f"[{self.where}] unknown key(s) {unknown}; accepted keys are {sorted(self.used)}"
+            )
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """``simulate()`` options from ``[run]`` (see :func:`rockdem.simulate.simulate`)."""
+
+    duration: float
+    dt: float | None = None
+    timestep_rule: str = "bound"
+    safety: float = 0.9
+    record_interval: float = 0.002
+
+
+@dataclass(frozen=True)
+class Case:
+    """A built case: the model, run options, monitors and output settings."""
+
+    name: str
+    model: Model
+    run: RunOptions
+    monitors: dict[str, Monitor]
+    output: dict[str, Any]
+    data: dict[str, Any]
+
+
+SpecimenBuilder = Callable[[Table, ModelBuilder], dict[str, Monitor]]
+LoadingBuilder = Callable[[Table, ModelBuilder, dict[str, Monitor], dict[str, Any]], None]
+
+SPECIMENS: dict[str, SpecimenBuilder] = {}
+"""Specimen types: ``[specimen] type = NAME`` -> builder(table, model builder) -> monitors."""
+
+LOADINGS: dict[str, LoadingBuilder] = {}
+"""Loading types: ``[loading] type = NAME`` -> builder(table, model builder, monitors, context)."""
+
+
+def specimen(name: str) -> Callable[[SpecimenBuilder], SpecimenBuilder]:
+    """Register a specimen builder under ``name``."""
+
+    def deco(func: SpecimenBuilder) -> SpecimenBuilder:
+        SPECIMENS[name] = func
+        return func
+
+    return deco
+
+
+def loading(name: str) -> Callable[[LoadingBuilder], LoadingBuilder]:
+    """Register a loading builder under ``name``."""
+
+    def deco(func: LoadingBuilder) -> LoadingBuilder:
+        LOADINGS[name] = func
+        return func
+
+    return deco
+
+
+def joint_material(t: Table, *, spacing: float) -> JointMaterial:
+    """A joint material from keys ``kn`` [Pa/m] or ``youngs_modulus`` [Pa] (kn = E / spacing),
+    ``ks`` or ``poisson``, ``friction_angle_deg``, ``cohesion`` [Pa], ``tension`` [Pa],
+    ``residual_friction_angle_deg``, ``residual_cohesion`` [Pa], ``beta`` [s]."""
+    kn = t.optional_number("kn", positive=True)
+    e = t.optional_number("youngs_modulus", positive=True)
+    if (kn is None) == (e is None):
+        raise ValueError(f"[{t.where}] give exactly one of kn [Pa/m] or youngs_modulus [Pa] (kn = E / l)")
+    nu = t.number("poisson", 0.25)
+    kn = e / spacing if kn is None else kn
+    ks = t.optional_number("ks", positive=True)
+    from .materials import ks_from_kn
+
+    mat = JointMaterial(
+        kn=kn,
+        ks=ks_from_kn(kn, nu) if ks is None else ks,
+        friction_angle=t.number("friction_angle_deg", 30.0),
+        cohesion=t.number("cohesion", 0.0, min_=0.0),
+        tension=t.number("tension", 0.0, min_=0.0),
+        residual_friction_angle=t.optional_number("residual_friction_angle_deg"),
+        residual_cohesion=t.number("residual_cohesion", 0.0, min_=0.0),
+        beta=t.optional_number("beta"),
+    )
+    mat.validate(f"[{t.where}]")
+    return mat
+
+
+@specimen("block")
+def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
+    """A single rectangular block (width along x, the rocking direction) on a fixed foundation.
+
+    Keys: width, height, length [m], density [kg/m^3], points_across, points_along, and the
+    joint keys of :func:`joint_material` (with youngs_modulus, kn = E / height).
+    """
+    width = t.number("width", positive=True)
+    height = t.number("height", positive=True)
+    length = t.number("length", 1.0, positive=True)
+    density = t.number("density", 1800.0, positive=True)
+    pts = (t.integer("points_across", 2, min_=1), t.integer("points_along", 2, min_=1))
+    mat = joint_material(t, spacing=height)
+    b.default_material = mat
+    size = 2.0 * max(width, length, height)
+    b.add_box(size, size, 0.25 * size, base_center=(0.0, 0.0, -0.25 * size), driven="ground", group="foundation", name="foundation", points=(2, 2))
+    b.add_box(width, length, height, density=density, name="block", points=pts)
+    return {"top": ("block", (0.5 * width, 0.0, height))}
+
+
+@loading("free-rocking")
+def _free_rocking(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
+    """Tilt a block about its base edge to ``tilt_fraction`` of its instability angle and release.
+
+    Keys: block (name, default "block"), tilt_fraction (default 0.9), tilt_direction (default +x).
+    """
+    name = t.string("block", "block")
+    frac = t.number("tilt_fraction", 0.9, min_=0.0)
+    d = t.vector("tilt_direction", (1.0, 0.0, 0.0))
+    ctx["tilt_angle"] = b.tilt(name, frac, direction=d)
+
+
+@loading("gravity")
+def _gravity_only(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
+    """Gravity alone (settlement, static checks)."""
+
+
+def load_case(path: str | Path) -> dict[str, Any]:
+    """Read a TOML case file into a dict (no validation yet)."""
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"case file {p} does not exist")
+    try:
+        with p.open("rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{p}: not valid TOML: {exc}") from None
+    data.setdefault("name", p.stem)
+    return data
+
+
+def example_names() -> list[str]:
+    """Names of the built-in example cases."""
+    return sorted(f.name[:-5] for f in resources.files("rockdem.cases").iterdir() if f.name.endswith(".toml"))
+
+
+def example_case(name: str) -> dict[str, Any]:
+    """A built-in example case as a dict."""
+    if name not in example_names():
+        raise ValueError(f"unknown example {name!r}; built-in examples are {example_names()}")
+    data = tomllib.loads(resources.files("rockdem.cases").joinpath(f"{name}.toml").read_text())
+    data.setdefault("name", name)
+    return data
+
+
+def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
+    """Apply ``table.key=value`` overrides (value parsed as TOML, else kept as a string)."""
+    out = copy.deepcopy(data)
+    for item in overrides:
+        if "=" not in item:
+            raise ValueError(f"--set {item!r}: use table.key=value, e.g. damping.beta=0.005")
+        path, value = item.split("=", 1)
+        try:
+            parsed = tomllib.loads(f"v = {value}")["v"]
+        except tomllib.TOMLDecodeError:
+            parsed = value
+        keys = path.strip().split(".")
+        node = out
+        for k in keys[:-1]:
+            node = node.setdefault(k, {})
+            if not isinstance(node, dict):
+                raise ValueError(f"--set {item!r}: {k} is not a table")
+        node[keys[-1]] = parsed
+    return out
+
+
+def parse_case(data: Mapping[str, Any]) -> Case:
+    """Validate a case dict and build its model."""
+    top = Table(data, "case")
+    name = top.string("name", "case")
+    top.string("description", "")
+    run_t = top.sub("run")
+    run = RunOptions(
+        duration=run_t.number("duration", positive=True),
+        dt=run_t.optional_number("dt", positive=True),
+        timestep_rule=run_t.string("timestep_rule", "bound", choices=("bound", "3dec")),
+        safety=run_t.number("safety", 0.9, positive=True),
+        record_interval=run_t.number("record_interval", 0.002, positive=True),
+    )
+    run_t.finish()
+    damp_t = top.sub("damping")
+    damping = Damping(
+        alpha=damp_t.number("alpha", 0.0, min_=0.0),
+        beta=damp_t.number("beta", 0.0, min_=0.0),
+        alpha_relative=damp_t.boolean("alpha_relative", False),
+        local=damp_t.number("local", 0.0, min_=0.0),
+    )
+    damp_t.finish()
+    spec_t = top.sub("specimen")
+    kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
+    grav = spec_t.number("gravity", 9.81, min_=0.0)
+    builder = ModelBuilder(gravity=(0.0, 0.0, -grav))
+    monitors = SPECIMENS[kind](spec_t, builder)
+    spec_t.finish()
+    load_t = top.sub("loading")
+    lkind = load_t.string("type", "gravity", choices=tuple(sorted(LOADINGS)))
+    ctx: dict[str, Any] = {"run": run}
+    LOADINGS[lkind](load_t, builder, monitors, ctx)
+    load_t.finish()
+    out_t = top.sub("output")
+    output = {
+        "directory": out_t.string("directory", ""),
+        "plot": out_t.boolean("plot", True),
+        "csv": out_t.boolean("csv", True),
+    }
+    out_t.finish()
+    top.finish()
+    model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)))
+    return Case(name, model, run, monitors, output, dict(data))
+
+
+def build_case(data: Mapping[str, Any]) -> Case:
+    """Alias of :func:`parse_case` (validate and build)."""
+    return parse_case(data)

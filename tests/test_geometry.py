@@ -1,0 +1,91 @@
+"""Geometry: mass properties by the divergence theorem, faces, interface points, validation."""
+
+import numpy as np
+import pytest
+
+from rockdem.geometry import box, convex_hull, face_points, mass_properties
+
+
+def test_box_mass_properties_closed_form():
+    # Rectangular prism: m = rho b l h, I_xx = m (l^2 + h^2) / 12 etc.
+    b, l, h, rho = 0.2, 1.0, 2.0, 1800.0
+    mp = mass_properties(box(b, l, h, center=(1.0, -2.0, 3.0)), rho)
+    m = rho * b * l * h
+    assert mp.mass == pytest.approx(m, rel=1e-12)
+    np.testing.assert_allclose(mp.centroid, [1.0, -2.0, 3.0], atol=1e-12)
+    expected = np.diag([m * (l**2 + h**2), m * (b**2 + h**2), m * (b**2 + l**2)]) / 12.0
+    np.testing.assert_allclose(mp.inertia, expected, rtol=1e-12, atol=1e-9)
+
+
+def test_tetrahedron_mass_properties_closed_form():
+    # Unit right tetrahedron: V = 1/6, centroid (1/4, 1/4, 1/4); about the origin
+    # integral of x^2 dV = 1/60 and of x y dV = 1/120 (standard results).
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    mp = mass_properties(convex_hull(v), 1.0)
+    assert mp.volume == pytest.approx(1 / 6)
+    np.testing.assert_allclose(mp.centroid, [0.25] * 3)
+    cov_origin = np.full((3, 3), 1 / 120) + np.eye(3) * (1 / 60 - 1 / 120)
+    cov = cov_origin - mp.volume * np.outer(mp.centroid, mp.centroid)
+    np.testing.assert_allclose(mp.inertia, np.trace(cov) * np.eye(3) - cov, atol=1e-12)
+
+
+def test_hull_merges_coplanar_faces_and_drops_edge_midpoints():
+    v = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
+    v = np.vstack([v, [[0.5, 0.0, 0.0]]])  # a point on an edge is not a corner
+    poly = convex_hull(v)
+    assert len(poly.faces) == 6 and all(len(f) == 4 for f in poly.faces)
+    assert len(poly.vertices) == 8
+
+
+@pytest.mark.parametrize("n_across,n_along", [(1, 1), (2, 2), (3, 2), (10, 4), (15, 2)])
+def test_interface_point_areas_sum_to_face_area(n_across, n_along):
+    poly = box(0.2, 1.0, 2.0)
+    for f in range(6):
+        pts, areas = face_points(poly, f, n_across, n_along)
+        face = poly.vertices[poly.faces[f]]
+        area = 0.5 * np.linalg.norm(np.cross(face[2] - face[0], face[1] - face[0])) * 2
+        assert areas.sum() == pytest.approx(area, rel=1e-12)
+        assert len(pts) == n_across * n_along
+        assert np.all(poly.contains(pts, tol=1e-12))
+
+
+def test_two_points_across_are_the_face_corners():
+    poly = box(0.2, 1.0, 2.0)
+    bottom = int(np.argmin(poly.normals[:, 2]))
+    pts, areas = face_points(poly, bottom, 2, 2)
+    corners = poly.vertices[poly.faces[bottom]]
+    assert {tuple(np.round(p, 12)) for p in pts} == {tuple(np.round(c, 12)) for c in corners}
+    np.testing.assert_allclose(areas, 0.2 * 1.0 / 4)
+    # "Across" is the short side: 5 points across a 0.2 x 1 face are spaced 0.05 m in x.
+    pts5, _ = face_points(poly, bottom, 5, 2)
+    assert len(np.unique(np.round(pts5[:, 0], 9))) == 5
+
+
+def test_triangular_face_points_lie_inside_and_conserve_area():
+    wedge = convex_hull([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1]])
+    for f, face in enumerate(wedge.faces):
+        pts, areas = face_points(wedge, f, 4, 4)
+        v = wedge.vertices[face]
+        area = 0.5 * np.linalg.norm(sum(np.cross(v[i], v[(i + 1) % len(v)]) for i in range(len(v))))
+        assert areas.sum() == pytest.approx(area, rel=1e-9)
+        assert np.all(wedge.contains(pts, tol=1e-9))
+
+
+@pytest.mark.parametrize(
+    "vertices,message",
+    [
+        ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], "flat"),
+        ([[0, 0, 0]] * 5, "coincide"),
+        ([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.1, 0.1, 0.1]], "not convex"),
+        ([[0, 0, 0], [1, 0, 0], [0, 1, 0]], "n >= 4"),
+    ],
+)
+def test_bad_vertices_are_refused_with_a_clear_message(vertices, message):
+    with pytest.raises(ValueError, match=message):
+        convex_hull(vertices)
+
+
+@pytest.mark.parametrize("dims", [(0, 1, 1), (1, -2, 1), (1, 1, float("nan"))])
+def test_box_sizes_must_be_positive(dims):
+    with pytest.raises(ValueError, match="must be a positive length"):
+        box(*dims)
