@@ -337,3 +337,18 @@ def parse_case(data: Mapping[str, Any]) -> Case:
 def build_case(data: Mapping[str, Any]) -> Case:
     """Alias of :func:`parse_case` (validate and build)."""
     return parse_case(data)
+
+
+def _register_builtin_types() -> None:
+    """Import the modules that register more specimen and loading types (if present)."""
+    import importlib
+
+    for name in ("rockdem.specimens", "rockdem.loading"):
+        try:
+            importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name != name:
+                raise
+
+
+_register_builtin_types()
