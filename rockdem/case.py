@@ -109,7 +109,7 @@ class Table:
 
     def sub(self, key: str) -> "Table":
         """A nested table (empty when absent)."""
-        return Table(self._get(key, {}), f"{self.where}.{key}")
+        return Table(self._get(key, {}), key if self.where == "case" else f"{self.where}.{key}")
 
     def raw(self, key: str, default: Any = None) -> Any:
         return self._get(key, default)

@@ -1,0 +1,95 @@
+"""Engine benchmarks (issue 2). Run: ``python benchmarks/bench_engine.py`` (prints figures).
+
+(a) The paper's Table 2 block (B = 0.2 m, H = 2 m, L = 1 m, 1800 kg/m^3, E = 1800 MPa, kn = E/H)
+    in free rocking for 10 s with 2, 3, 4, 5, 10 and 15 interface points across the thickness:
+    SP damping (beta = 0.00693 s, as the paper) and MP damping (alpha = 22.4 beta + 0.05, the
+    paper's pragmatic relation); wall time after compilation and the SP/MP ratio.
+    3DEC (paper Table 2): 6, 13, 16, 20, 34, 54 hours; SP/MP 50 to 350 (§3.1).
+(b) A stack-bond wall of >= 1000 bricks settling under gravity: sub-contact updates per second
+    on one core.
+(c) Cold start: ``rockdem run --example free-rocking`` with an empty Numba cache, then warm.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, ModelBuilder
+from rockdem.simulate import simulate
+from rockdem.state import initial_state
+
+BETA = 0.00693
+PAPER_HOURS = {2: 6, 3: 13, 4: 16, 5: 20, 10: 34, 15: 54}
+
+
+def table2_block(points: int, damping: Damping):
+    b = ModelBuilder(points=(points, 2))
+    b.default_material = JointMaterial.from_modulus(1.8e9, 2.0, friction_angle=89.0)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground", group="ground", points=(2, 2))
+    b.add_box(0.2, 1.0, 2.0, density=1800, name="wall")
+    b.tilt("wall", 0.9)
+    return b.finalize(damping=damping)
+
+
+def bench_table2() -> None:
+    print("(a) Table 2 block, 10 s of free rocking (wall time after compilation)")
+    print(f"{'points':>6} {'SP steps':>9} {'SP [s]':>8} {'MP steps':>9} {'MP [s]':>8} {'SP/MP':>6} {'3DEC SP [h]':>11}")
+    simulate(table2_block(2, Damping(beta=BETA)), 0.05, progress=False)  # compile
+    for n in (2, 3, 4, 5, 10, 15):
+        sp = simulate(table2_block(n, Damping(beta=BETA)), 10.0, record_interval=0.002, progress=False)
+        mp = simulate(table2_block(n, Damping(alpha=22.4 * BETA + 0.05)), 10.0, record_interval=0.002, progress=False)
+        ratio = sp.attrs["runtime_s"] / mp.attrs["runtime_s"]
+        print(
+            f"{n:>6} {sp.attrs['steps']:>9} {sp.attrs['runtime_s']:>8.3f} {mp.attrs['steps']:>9} "
+            f"{mp.attrs['runtime_s']:>8.3f} {ratio:>6.2f} {PAPER_HOURS[n]:>11}"
+        )
+
+
+def bench_wall(courses: int = 40, per_course: int = 25) -> None:
+    b = ModelBuilder(points=(2, 3))
+    b.set_material("brick", "brick", JointMaterial(kn=1e10, friction_angle=35, cohesion=2e5, tension=1e5))
+    b.set_material("brick", "ground", JointMaterial(kn=1e10, friction_angle=35))
+    b.set_material("ground", "ground", JointMaterial(kn=1e10))
+    lx, ly, lz = 0.1, 0.23, 0.075
+    b.add_box(1.0, per_course * ly + 1.0, 0.3, base_center=(0, 0, -0.3), driven=True, name="ground", group="ground")
+    y0 = -0.5 * per_course * ly
+    for c in range(courses):
+        for k in range(per_course):
+            b.add_box(lx, ly, lz, base_center=(0, y0 + (k + 0.5) * ly, c * lz), density=1800, group="brick", name=f"b{c}_{k}")
+    model = b.finalize(damping=Damping(alpha=5.0))
+    s, _ = initial_state(model)
+    tracked = int(s.track_count[0])
+    simulate(model, 1e-3, progress=False)  # compile
+    ds = simulate(model, 0.05, record_interval=0.01, progress=False)
+    steps, runtime = ds.attrs["steps"], ds.attrs["runtime_s"]
+    print(f"(b) wall of {courses * per_course} bricks, {tracked} tracked sub-contacts, {steps} steps in {runtime:.2f} s")
+    print(f"    sub-contact updates per second (1 core): {tracked * steps / runtime:.3e}")
+
+
+def bench_cold_start() -> None:
+    exe = [sys.executable, "-m", "rockdem.cli", "run", "--example", "free-rocking", "--quiet"]
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as out:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        for label in ("cold (empty Numba cache)", "warm"):
+            t0 = time.perf_counter()
+            subprocess.run(exe + ["--out", out], env=env, check=True, capture_output=True)
+            print(f"(c) rockdem run --example free-rocking, {label}: {time.perf_counter() - t0:.1f} s")
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+    which = sys.argv[1:] or ["table2", "wall", "cold"]
+    if "table2" in which:
+        bench_table2()
+    if "wall" in which:
+        bench_wall()
+    if "cold" in which:
+        bench_cold_start()
+    _ = np
