@@ -132,6 +132,7 @@ class RunOptions:
     timestep_rule: str = "bound"
     safety: float = 0.9
     record_interval: float = 0.002
+    contact_tolerance: float | None = None
 
 
 @dataclass(frozen=True)
@@ -301,6 +302,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         timestep_rule=run_t.string("timestep_rule", "bound", choices=("bound", "3dec")),
         safety=run_t.number("safety", 0.9, positive=True),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
+        contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
     )
     run_t.finish()
     damp_t = top.sub("damping")
@@ -330,7 +332,11 @@ def parse_case(data: Mapping[str, Any]) -> Case:
     }
     out_t.finish()
     top.finish()
-    model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)))
+    model = builder.finalize(
+        damping=damping,
+        rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
+        contact_tolerance=run.contact_tolerance,
+    )
     return Case(name, model, run, monitors, output, dict(data))
 
 

@@ -344,7 +344,8 @@ class ModelBuilder:
         Args:
             damping: Rayleigh / local damping.
             contact_tolerance: gap [m] within which sub-contacts are tracked between detections;
-                default 1 % of the smallest block dimension. The point-in-face test uses a tenth.
+                default 1 % of the smallest dimension of the free blocks. The point-in-face test
+                uses a tenth of it plus the point's own penetration.
             rocking_axis: world axis of the recorded ``rocking_angle`` (default y: rocking in x-z).
         """
         if not self._blocks:
@@ -425,8 +426,8 @@ class ModelBuilder:
             om0[b] = rot.T @ blk.angular_velocity if free else 0.0
             local = (blk.poly.vertices - mp.centroid) @ rot
             radius[b] = float(np.max(np.linalg.norm(local, axis=1)))
-            extents = np.ptp(local, axis=0)
-            min_dim = min(min_dim, float(extents.min()))
+            if blk.driven is False:
+                min_dim = min(min_dim, float(np.ptp(local, axis=0).min()))
             base_v = vstart[-1]
             vloc.append(local)
             vstart.append(base_v + len(local))

@@ -20,19 +20,18 @@ from numba import njit
 from .layout import ModelArrays, Scratch, State
 
 
-@njit(cache=True, inline="always")
-def _flex(m: ModelArrays, sc: Scratch, b: int, r0: float, r1: float, r2: float, d0: float, d1: float, d2: float) -> float:
-    """1/m + sum_j (r x d)_j^2 / I_j in block b's principal frame (0 for driven blocks)."""
-    if not m.block_free[b]:
+@njit(cache=True)
+def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, r1: float, r2: float, d0: float, d1: float, d2: float) -> float:
+    """1/m + sum_j (r x d)_j^2 / I_j in a block's principal frame (0 for driven blocks: inv_mass 0)."""
+    if inv_mass == 0.0:
         return 0.0
     c0 = r1 * d2 - r2 * d1
     c1 = r2 * d0 - r0 * d2
     c2 = r0 * d1 - r1 * d0
-    rot = sc.rotation[b]
-    out = m.block_inv_mass[b]
+    out = inv_mass
     for j in range(3):
         cj = rot[0, j] * c0 + rot[1, j] * c1 + rot[2, j] * c2
-        out += cj * cj * m.block_inv_inertia[b, j]
+        out += cj * cj * inv_inertia[j]
     return out
 
 
@@ -55,29 +54,36 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch, out: np.ndarray) -> Non
         area = m.point_area[p]
         rt = sc.rotation[t]
         ro = sc.rotation[o]
-        n = rt @ m.face_normal[tf]
+        fn = m.face_normal[tf]
+        n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
+        n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
+        n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
         pl = m.point_local[p]
-        r_o = ro @ pl
-        r_t = r_o + s.position[o] - s.position[t]
-        # tangents
-        if abs(n[0]) < 0.9:
-            t1 = np.array([0.0, n[2], -n[1]])
+        a0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2]
+        a1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2]
+        a2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2]
+        b0 = a0 + s.position[o, 0] - s.position[t, 0]
+        b1 = a1 + s.position[o, 1] - s.position[t, 1]
+        b2 = a2 + s.position[o, 2] - s.position[t, 2]
+        # Two unit tangents of the contact plane.
+        if abs(n0) < 0.9:
+            u0, u1, u2 = 0.0, n2, -n1
         else:
-            t1 = np.array([-n[2], 0.0, n[0]])
-        t1 /= math.sqrt(t1[0] ** 2 + t1[1] ** 2 + t1[2] ** 2)
-        t2 = np.array([n[1] * t1[2] - n[2] * t1[1], n[2] * t1[0] - n[0] * t1[2], n[0] * t1[1] - n[1] * t1[0]])
+            u0, u1, u2 = -n2, 0.0, n0
+        inv = 1.0 / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+        u0, u1, u2 = u0 * inv, u1 * inv, u2 * inv
+        w0, w1, w2 = n1 * u2 - n2 * u1, n2 * u0 - n0 * u2, n0 * u1 - n1 * u0
+        kn_ = m.mat_kn[go, gt] * area
+        ks_ = m.mat_ks[go, gt] * area
         for dir_ in range(3):
             if dir_ == 0:
-                d = n
-                k_ = m.mat_kn[go, gt] * area
+                d0, d1, d2, k_ = n0, n1, n2, kn_
             elif dir_ == 1:
-                d = t1
-                k_ = m.mat_ks[go, gt] * area
+                d0, d1, d2, k_ = u0, u1, u2, ks_
             else:
-                d = t2
-                k_ = m.mat_ks[go, gt] * area
-            uo = math.sqrt(k_ * _flex(m, sc, o, r_o[0], r_o[1], r_o[2], d[0], d[1], d[2]))
-            ut = math.sqrt(k_ * _flex(m, sc, t, r_t[0], r_t[1], r_t[2], d[0], d[1], d[2]))
+                d0, d1, d2, k_ = w0, w1, w2, ks_
+            uo = math.sqrt(k_ * _flex(ro, m.block_inv_mass[o], m.block_inv_inertia[o], a0, a1, a2, d0, d1, d2))
+            ut = math.sqrt(k_ * _flex(rt, m.block_inv_mass[t], m.block_inv_inertia[t], b0, b1, b2, d0, d1, d2))
             row[o] += uo * (uo + ut)
             row[t] += ut * (ut + uo)
         bt = m.mat_beta[go, gt]

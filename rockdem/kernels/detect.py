@@ -30,8 +30,9 @@ def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
     nb = m.block_mass.shape[0]
     for b in range(nb):
         r = sc.rotation[b]
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
+        for i in range(3):
+            sc.aabb[b, i] = np.inf
+            sc.aabb[b, 3 + i] = -np.inf
         for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
             for i in range(3):
                 x = (
@@ -41,29 +42,30 @@ def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
                     + s.position[b, i]
                 )
                 sc.world_vertex[v, i] = x
-                lo[i] = min(lo[i], x)
-                hi[i] = max(hi[i], x)
+                sc.aabb[b, i] = min(sc.aabb[b, i], x)
+                sc.aabb[b, 3 + i] = max(sc.aabb[b, 3 + i], x)
         for i in range(3):
-            sc.aabb[b, i] = lo[i] - m.contact_tol
-            sc.aabb[b, 3 + i] = hi[i] + m.contact_tol
+            sc.aabb[b, i] -= m.contact_tol
+            sc.aabb[b, 3 + i] += m.contact_tol
 
 
 @njit(cache=True)
-def _face_separation(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, f: int) -> float:
-    """Separation of block b from face f of block a along that face's world normal [m]."""
-    r = sc.rotation[a]
-    n0 = r[0, 0] * m.face_normal[f, 0] + r[0, 1] * m.face_normal[f, 1] + r[0, 2] * m.face_normal[f, 2]
-    n1 = r[1, 0] * m.face_normal[f, 0] + r[1, 1] * m.face_normal[f, 1] + r[1, 2] * m.face_normal[f, 2]
-    n2 = r[2, 0] * m.face_normal[f, 0] + r[2, 1] * m.face_normal[f, 1] + r[2, 2] * m.face_normal[f, 2]
-    d = n0 * s.position[a, 0] + n1 * s.position[a, 1] + n2 * s.position[a, 2] + m.face_offset[f]
+def _face_separation(
+    r: np.ndarray, pos: np.ndarray, normal: np.ndarray, offset: float, world_vertex: np.ndarray, v0: int, v1: int
+) -> float:
+    """Separation [m] of the vertices v0:v1 from a face (body normal, offset) of a block at (r, pos)."""
+    n0 = r[0, 0] * normal[0] + r[0, 1] * normal[1] + r[0, 2] * normal[2]
+    n1 = r[1, 0] * normal[0] + r[1, 1] * normal[1] + r[1, 2] * normal[2]
+    n2 = r[2, 0] * normal[0] + r[2, 1] * normal[1] + r[2, 2] * normal[2]
+    d = n0 * pos[0] + n1 * pos[1] + n2 * pos[2] + offset
     lo = np.inf
-    for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
-        x = n0 * sc.world_vertex[v, 0] + n1 * sc.world_vertex[v, 1] + n2 * sc.world_vertex[v, 2]
+    for v in range(v0, v1):
+        x = n0 * world_vertex[v, 0] + n1 * world_vertex[v, 1] + n2 * world_vertex[v, 2]
         lo = min(lo, x)
     return lo - d
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def point_in_target(
     m: ModelArrays, s: State, sc: Scratch, p: int, t: int, tf: int, out: np.ndarray
 ) -> float:
@@ -92,7 +94,7 @@ def point_in_target(
     return n[0] * q0 + n[1] * q1 + n[2] * q2 - m.face_offset[tf]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _release(s: State, p: int) -> None:
     """Forget the partner of point p; a bond torn apart by separation counts as a tension failure."""
     if s.point_bonded[p]:
@@ -106,17 +108,23 @@ def _release(s: State, p: int) -> None:
     s.point_normal_force[p] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarray) -> None:
     best = -np.inf
     ref = -1
     rface = -1
     for f in range(m.block_face_start[a], m.block_face_start[a + 1]):
-        sep = _face_separation(m, s, sc, a, b, f)
+        sep = _face_separation(
+            sc.rotation[a], s.position[a], m.face_normal[f], m.face_offset[f], sc.world_vertex,
+            m.block_vertex_start[b], m.block_vertex_start[b + 1],
+        )
         if sep > best:
             best, ref, rface = sep, a, f
     for f in range(m.block_face_start[b], m.block_face_start[b + 1]):
-        sep = _face_separation(m, s, sc, b, a, f)
+        sep = _face_separation(
+            sc.rotation[b], s.position[b], m.face_normal[f], m.face_offset[f], sc.world_vertex,
+            m.block_vertex_start[a], m.block_vertex_start[a + 1],
+        )
         if sep > best:
             best, ref, rface = sep, b, f
     if best < sc.sums[5]:
@@ -128,14 +136,17 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarr
     oth = b if ref == a else a
     rr = sc.rotation[ref]
     ro = sc.rotation[oth]
-    nref = rr @ m.face_normal[rface]
+    fr = m.face_normal[rface]
+    nref0 = rr[0, 0] * fr[0] + rr[0, 1] * fr[1] + rr[0, 2] * fr[2]
+    nref1 = rr[1, 0] * fr[0] + rr[1, 1] * fr[1] + rr[1, 2] * fr[2]
+    nref2 = rr[2, 0] * fr[0] + rr[2, 1] * fr[1] + rr[2, 2] * fr[2]
     iface = -1
     lowest = np.inf
     for g in range(m.block_face_start[oth], m.block_face_start[oth + 1]):
         c = (
-            (ro[0, 0] * m.face_normal[g, 0] + ro[0, 1] * m.face_normal[g, 1] + ro[0, 2] * m.face_normal[g, 2]) * nref[0]
-            + (ro[1, 0] * m.face_normal[g, 0] + ro[1, 1] * m.face_normal[g, 1] + ro[1, 2] * m.face_normal[g, 2]) * nref[1]
-            + (ro[2, 0] * m.face_normal[g, 0] + ro[2, 1] * m.face_normal[g, 1] + ro[2, 2] * m.face_normal[g, 2]) * nref[2]
+            (ro[0, 0] * m.face_normal[g, 0] + ro[0, 1] * m.face_normal[g, 1] + ro[0, 2] * m.face_normal[g, 2]) * nref0
+            + (ro[1, 0] * m.face_normal[g, 0] + ro[1, 1] * m.face_normal[g, 1] + ro[1, 2] * m.face_normal[g, 2]) * nref1
+            + (ro[2, 0] * m.face_normal[g, 0] + ro[2, 1] * m.face_normal[g, 1] + ro[2, 2] * m.face_normal[g, 2]) * nref2
         )
         if c < lowest:
             lowest, iface = c, g
@@ -154,7 +165,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarr
         if sc.seen[p] == passid:
             continue
         gap = point_in_target(m, s, sc, p, target, tface, tmp)
-        if gap > m.contact_tol or tmp[3] > m.contact_tol:
+        if gap > m.contact_tol or tmp[3] > m.contact_tol + max(-gap, 0.0):
             continue
         sc.seen[p] = passid
         if s.point_partner[p] != target:

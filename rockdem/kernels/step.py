@@ -114,7 +114,9 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
         sc.dashpot_force[k, 0] = 0.0
         sc.dashpot_force[k, 1] = 0.0
         sc.dashpot_force[k, 2] = 0.0
-        if tmp[3] > m.edge_tol or (un <= 0.0 and not s.point_bonded[p]):
+        # A point may sit outside the face polygon by its own penetration when the partner turns
+        # about the shared edge (soft joints), plus the edge tolerance.
+        if tmp[3] > m.edge_tol + max(un, 0.0) or (un <= 0.0 and not s.point_bonded[p]):
             # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
             if s.point_bonded[p]:
                 e_bond += spring_energy(s.point_normal_force[p], kna)

@@ -1,0 +1,491 @@
+"""Measurements the paper uses to judge damping, on plain arrays and on rockdem results.
+
+Functions on plain NumPy arrays come first (usable on a measured history read from a CSV), then
+thin adapters for a rockdem result (an ``xarray.Dataset`` with coordinate ``time`` [s], variables
+``rocking_angle (time, block)`` [rad], ``block_position (time, block, xyz)`` [m], ``block_free
+(block)``). References are to Galvez et al. 2022 (the founding paper, "§") and DESIGN §4.
+
+Definitions:
+    * half-cycle peak: a local maximum of |theta| between two impacts (zero crossings or touches);
+    * apparent restitution e_a (Eq. 6):
+      e_a(n) = [(1 - (1 - |theta_n|/eta)^2) / (1 - (1 - |theta_0|/eta)^2)]^(1/(2n));
+    * WME = sum |x_i - y_i| |x_i| / sum x_i^2 on the reference time base (x reference, y simulation);
+    * bouncing magnitude (§3.1, Fig. 5B) = airborne amplitude / airborne duration [m/s].
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.signal import find_peaks
+
+__all__ = [
+    "HalfCyclePeaks",
+    "Restitution",
+    "Bouncing",
+    "half_cycle_peaks",
+    "apparent_restitution",
+    "wme",
+    "rest_time",
+    "bouncing",
+    "rocking_lift",
+    "max_rotation",
+    "residual_drift",
+    "overturned",
+    "rocking_onset_time",
+    "summarize",
+    "lowest_point_height",
+    "summarize_result",
+]
+
+
+@dataclass(frozen=True)
+class HalfCyclePeaks:
+    """Peaks of |theta| per half cycle.
+
+    Attributes:
+        time: (k,) peak times [s].
+        value: (k,) signed peak values (same unit as the input, e.g. rad).
+    """
+
+    time: NDArray[np.float64]
+    value: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Restitution:
+    """Apparent coefficient of restitution (Eq. 6).
+
+    Attributes:
+        per_impact: (n,) e_a(n) for impacts n = 1..N [-].
+        mean: mean of ``per_impact`` [-] (nan if there is no impact).
+    """
+
+    per_impact: NDArray[np.float64]
+    mean: float
+
+
+@dataclass(frozen=True)
+class Bouncing:
+    """Airborne phases of a block (§3.1, Fig. 5B).
+
+    Attributes:
+        start: (k,) take-off times [s].
+        duration: (k,) airborne durations [s].
+        amplitude: (k,) maximum height above the contact level [m].
+        magnitude: (k,) amplitude / duration [m/s].
+        max_magnitude: largest magnitude [m/s] (0 without any airborne phase).
+    """
+
+    start: NDArray[np.float64]
+    duration: NDArray[np.float64]
+    amplitude: NDArray[np.float64]
+    magnitude: NDArray[np.float64]
+    max_magnitude: float
+
+
+def _history(t: ArrayLike, x: ArrayLike, name: str = "x") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Validate a history: 1-D, same length, finite, strictly increasing time."""
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(x, dtype=float)
+    if t.ndim != 1 or x.ndim != 1 or t.shape != x.shape:
+        raise ValueError(f"{name}: time and values must be 1-D arrays of equal length, got {t.shape} and {x.shape}")
+    if len(t) < 2:
+        raise ValueError(f"{name}: need at least 2 samples, got {len(t)}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(x))):
+        raise ValueError(f"{name}: time and values must be finite (remove NaN/inf rows)")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError(f"{name}: time must be strictly increasing (sort the rows, drop duplicates)")
+    return t, x
+
+
+def half_cycle_peaks(
+    t: ArrayLike, theta: ArrayLike, *, min_prominence: float | None = None, refine: bool = True
+) -> HalfCyclePeaks:
+    """Peak |theta| of every half cycle (DESIGN §4).
+
+    A peak is a local maximum of |theta| whose prominence exceeds ``min_prominence``, so both
+    two-sided rocking (sign changes) and one-sided rocking (touches of zero) are handled. A history
+    that starts at its maximum (free rocking released from theta_0) gives theta_0 as the first peak.
+    The last, unfinished half cycle is not a peak.
+
+    Args:
+        t: (n,) time [s], strictly increasing.
+        theta: (n,) rotation [rad] (or any oscillating history).
+        min_prominence: smallest accepted prominence, same unit as theta; default 1e-3 x max |theta|.
+        refine: refine interior peaks by a parabola through the three samples around them
+            (error O(dt^3) instead of O(dt^2) for smooth peaks).
+
+    Returns:
+        HalfCyclePeaks with (k,) times [s] and signed values.
+    """
+    t, x = _history(t, theta, "half_cycle_peaks")
+    a = np.abs(x)
+    if min_prominence is None:
+        min_prominence = 1e-3 * float(a.max())
+    padded = np.concatenate(([0.0], a))  # lets a release at t[0] count as a peak
+    idx, _ = find_peaks(padded, prominence=max(min_prominence, np.finfo(float).tiny))
+    idx = idx - 1
+    times, values = t[idx].copy(), x[idx].copy()
+    if refine:
+        for k, i in enumerate(idx):
+            if 0 < i < len(x) - 1:
+                times[k], values[k] = _parabola_peak(t[i - 1 : i + 2], x[i - 1 : i + 2])
+    return HalfCyclePeaks(times, values)
+
+
+def _parabola_peak(t3: NDArray[np.float64], x3: NDArray[np.float64]) -> tuple[float, float]:
+    """Vertex of the parabola through three samples (falls back to the middle sample)."""
+    c = np.polyfit(t3 - t3[1], x3, 2)
+    if c[0] == 0.0:
+        return float(t3[1]), float(x3[1])
+    tv = -c[1] / (2.0 * c[0])
+    if not (t3[0] - t3[1] <= tv <= t3[2] - t3[1]):
+        return float(t3[1]), float(x3[1])
+    return float(t3[1] + tv), float(np.polyval(c, tv))
+
+
+def apparent_restitution(peaks: ArrayLike, theta0: float, eta: float, *, exact: bool = False) -> Restitution:
+    """Apparent coefficient of restitution per impact (paper Eq. 6).
+
+    e_a(n) = [(1 - (1 - |theta_n|/eta)^2) / (1 - (1 - |theta_0|/eta)^2)]^(1/(2n)), n = 1..N.
+
+    Eq. 6 inverts Housner's *linearised* energy; with ``exact=True`` the exact potential energy of
+    the rectangular block is used instead, e_a(n) = [(cos(eta-|theta_n|) - cos eta) /
+    (cos(eta-|theta_0|) - cos eta)]^(1/(2n)), which inverts the nonlinear Housner model exactly.
+
+    Args:
+        peaks: (N,) peak rotations |theta_n| after impacts 1..N [rad] (sign ignored).
+        theta0: initial (release) amplitude [rad].
+        eta: slenderness angle atan(B/H) [rad].
+        exact: use the exact energy form instead of Eq. 6.
+
+    Returns:
+        Restitution with per-impact values and their mean.
+
+    Raises:
+        ValueError: eta not in (0, pi/2), or theta0 not in (0, eta).
+    """
+    if not (0.0 < eta < 0.5 * np.pi):
+        raise ValueError(f"eta must be the slenderness angle in (0, pi/2) rad, got {eta!r}")
+    th0 = abs(float(theta0))
+    if not (0.0 < th0 < eta):
+        raise ValueError(f"theta0 must lie in (0, eta = {eta:.6g}) rad, got {theta0!r} (a release beyond eta overturns)")
+    p = np.abs(np.asarray(peaks, dtype=float)).ravel()
+    if np.any(p > eta):
+        warnings.warn("apparent_restitution: some peaks exceed eta (overturning?); Eq. 6 is not defined there", stacklevel=2)
+    n = np.arange(1, len(p) + 1)
+
+    def energy(th: NDArray[np.float64] | float) -> NDArray[np.float64]:
+        if exact:
+            return np.cos(eta - np.asarray(th)) - np.cos(eta)
+        return 1.0 - (1.0 - np.asarray(th) / eta) ** 2
+
+    ratio = np.clip(energy(p) / energy(th0), 0.0, None)
+    e = ratio ** (1.0 / (2.0 * n))
+    return Restitution(e, float(np.mean(e)) if len(e) else float("nan"))
+
+
+def rest_time(t: ArrayLike, x: ArrayLike, *, rest_tol: float | None = None) -> float:
+    """End of the motion: the last time |x - x_final| exceeds ``rest_tol`` [s].
+
+    Args:
+        t: (n,) time [s].
+        x: (n,) history.
+        rest_tol: motion threshold, unit of x; default 1 % of max |x - x_final|.
+    """
+    t, x = _history(t, x, "rest_time")
+    dev = np.abs(x - x[-1])
+    tol = 0.01 * float(dev.max()) if rest_tol is None else float(rest_tol)
+    if tol < 0:
+        raise ValueError(f"rest_tol must be >= 0, got {rest_tol!r}")
+    moving = np.flatnonzero(dev > tol)
+    if len(moving) == 0:
+        return float(t[0])
+    return float(t[min(moving[-1] + 1, len(t) - 1)])
+
+
+def wme(
+    t_ref: ArrayLike,
+    x_ref: ArrayLike,
+    t_sim: ArrayLike,
+    x_sim: ArrayLike,
+    *,
+    cut_at_rest: bool = True,
+    rest_tol: float | None = None,
+) -> float:
+    """Weighted mean error between a reference and a simulated history (DESIGN §4, paper §3.1).
+
+    WME = sum_i |x_i - y_i| |x_i| / sum_i x_i^2, with x the reference at its own samples and y the
+    simulation linearly interpolated there. Amplitude-weighted; 0 for a perfect match; invariant to
+    a common scale factor; **not symmetric**: wme(x, y) != wme(y, x) in general (e.g. y = 2x gives
+    1 one way and 0.5 the other). Also wme(x, 0) = 1 and wme(x, -x) = 2.
+
+    Args:
+        t_ref, x_ref: (n,) reference time [s] and history.
+        t_sim, x_sim: (m,) simulated time [s] and history (any sampling).
+        cut_at_rest: keep only the reference samples up to the end of the reference motion
+            (:func:`rest_time`), so the late low-amplitude motion of the simulation does not count.
+        rest_tol: motion threshold for the cut, unit of x; default 1 % of the reference's range.
+
+    Returns:
+        WME [-].
+
+    Raises:
+        ValueError: bad histories, no overlap, or a reference identically zero.
+    """
+    tr, xr = _history(t_ref, x_ref, "wme reference")
+    ts, xs = _history(t_sim, x_sim, "wme simulation")
+    t_end = rest_time(tr, xr, rest_tol=rest_tol) if cut_at_rest else float(tr[-1])
+    keep = tr <= t_end
+    inside = keep & (tr >= ts[0]) & (tr <= ts[-1])
+    if not np.any(inside):
+        raise ValueError("wme: the simulation does not overlap the reference in time")
+    if np.count_nonzero(inside) < np.count_nonzero(keep):
+        warnings.warn(
+            f"wme: the simulation covers [{ts[0]:.4g}, {ts[-1]:.4g}] s only; reference samples up to "
+            f"{t_end:.4g} s outside it are ignored",
+            stacklevel=2,
+        )
+    x = xr[inside]
+    y = np.interp(tr[inside], ts, xs)
+    den = float(np.sum(x * x))
+    if den == 0.0:
+        raise ValueError("wme: the reference is identically zero on the compared interval")
+    return float(np.sum(np.abs(x - y) * np.abs(x)) / den)
+
+
+def rocking_lift(theta: ArrayLike, b: float, h: float) -> NDArray[np.float64]:
+    """Rise of the centroid of a B x H block rocking on a corner without lifting off [m].
+
+    z_c(theta) - z_c(0) = R [cos(eta - |theta|) - cos(eta)], R = semi-diagonal, eta = atan(b/h).
+    Subtract it from a centroid height history to keep only the airborne part for :func:`bouncing`.
+    """
+    r = 0.5 * np.hypot(b, h)
+    eta = np.arctan2(b, h)
+    th = np.abs(np.asarray(theta, dtype=float))
+    return r * (np.cos(eta - th) - np.cos(eta))
+
+
+def bouncing(
+    t: ArrayLike,
+    z: ArrayLike,
+    *,
+    z_rest: float | None = None,
+    tol: float | None = None,
+    z_contact: ArrayLike | None = None,
+) -> Bouncing:
+    """Airborne phases and bouncing magnitude from a height history (paper §3.1, Fig. 5B).
+
+    The block is airborne while d = z - z_contact exceeds ``tol``, with z_contact either an array
+    (the height the measured point would have in contact, e.g. the centroid's rest height plus
+    :func:`rocking_lift`) or the constant ``z_rest``. For each airborne phase: amplitude = max d,
+    duration = time above tol, magnitude = amplitude / duration. Pass the height of the block's
+    lowest point (:func:`lowest_point_height`) with its ground level as ``z_rest``, or the centroid
+    with ``z_contact``: the centroid alone also rises by plain rocking, which is not bouncing.
+
+    Args:
+        t: (n,) time [s].
+        z: (n,) height [m].
+        z_rest: contact level [m]; default z[0] (the block touches its support at the start).
+        tol: airborne threshold [m], > 0; default 1e-5 m (above the elastic joint overlap of
+            typical stiff joints, a few micrometres; lower it for small or very stiff models).
+        z_contact: (n,) contact height history [m], overrides ``z_rest``.
+
+    Returns:
+        Bouncing with per-phase arrays and the largest magnitude.
+    """
+    t, z = _history(t, z, "bouncing")
+    if z_contact is not None:
+        base = np.asarray(z_contact, dtype=float)
+        if base.shape != z.shape:
+            raise ValueError(f"bouncing: z_contact must have the shape of z {z.shape}, got {base.shape}")
+    else:
+        base = np.full_like(z, z[0] if z_rest is None else float(z_rest))
+    d = z - base
+    tol = 1e-5 if tol is None else float(tol)
+    if tol <= 0:
+        raise ValueError(f"bouncing: tol must be > 0 m, got {tol!r}")
+    air = d > tol
+    edges = np.diff(air.astype(np.int8))
+    starts = list(np.flatnonzero(edges == 1) + 1)
+    ends = list(np.flatnonzero(edges == -1) + 1)
+    if air[0]:
+        starts.insert(0, 0)
+    if air[-1]:
+        ends.append(len(z))
+    st, du, am = [], [], []
+    for i0, i1 in zip(starts, ends):
+        ta = _crossing(t, d - tol, i0 - 1, i0) if i0 > 0 else t[0]
+        tb = _crossing(t, d - tol, i1 - 1, i1) if i1 < len(z) else t[-1]
+        if tb <= ta:
+            continue
+        st.append(ta)
+        du.append(tb - ta)
+        am.append(float(d[i0:i1].max()))
+    du_a, am_a = np.array(du), np.array(am)
+    mag = am_a / du_a if len(du) else np.zeros(0)
+    return Bouncing(np.array(st), du_a, am_a, mag, float(mag.max()) if len(mag) else 0.0)
+
+
+def _crossing(t: NDArray[np.float64], f: NDArray[np.float64], i: int, j: int) -> float:
+    """Linear-interpolated zero of f between samples i and j."""
+    if f[j] == f[i]:
+        return float(t[j])
+    return float(t[i] + (t[j] - t[i]) * (0.0 - f[i]) / (f[j] - f[i]))
+
+
+def max_rotation(theta: ArrayLike) -> float:
+    """Largest |theta| of a history (same unit as theta)."""
+    th = np.asarray(theta, dtype=float)
+    if th.size == 0:
+        raise ValueError("max_rotation: empty history")
+    return float(np.max(np.abs(th)))
+
+
+def residual_drift(t: ArrayLike, x: ArrayLike, *, tail: float = 0.0) -> float:
+    """Residual value of a history: its mean over the last ``tail`` seconds (the last sample if 0).
+
+    Args:
+        t: (n,) time [s].
+        x: (n,) history (rotation [rad] or displacement [m]).
+        tail: averaging window at the end [s], >= 0.
+    """
+    t, x = _history(t, x, "residual_drift")
+    if tail < 0:
+        raise ValueError(f"residual_drift: tail must be >= 0 s, got {tail!r}")
+    sel = t >= t[-1] - tail
+    return float(np.mean(x[sel]))
+
+
+def overturned(theta: ArrayLike, eta: float, *, rtol: float = 1e-9) -> bool:
+    """Whether the history ends beyond the instability angle: |theta_end| >= eta (1 - rtol).
+
+    A block that went past eta and came back (possible under ground motion) is not overturned.
+    """
+    if not (0.0 < eta < 0.5 * np.pi):
+        raise ValueError(f"eta must be the slenderness angle in (0, pi/2) rad, got {eta!r}")
+    th = np.asarray(theta, dtype=float)
+    return bool(abs(th[-1]) >= eta * (1.0 - rtol))
+
+
+def rocking_onset_time(t: ArrayLike, theta: ArrayLike, threshold: float) -> float | None:
+    """First time |theta| exceeds ``threshold`` [s], or None if it never does.
+
+    Args:
+        t: (n,) time [s].
+        theta: (n,) rotation [rad].
+        threshold: rotation that counts as rocking [rad], > 0.
+    """
+    t, th = _history(t, theta, "rocking_onset_time")
+    if not threshold > 0:
+        raise ValueError(f"rocking_onset_time: threshold must be > 0 rad, got {threshold!r}")
+    above = np.flatnonzero(np.abs(th) > threshold)
+    return float(t[above[0]]) if len(above) else None
+
+
+def summarize(
+    t: ArrayLike,
+    theta: ArrayLike,
+    *,
+    eta: float | None = None,
+    onset_threshold: float | None = None,
+    z: ArrayLike | None = None,
+    z_rest: float | None = None,
+    bounce_tol: float | None = None,
+) -> dict[str, Any]:
+    """Summary of one rotation history (keys carry their unit).
+
+    Args:
+        t: (n,) time [s].
+        theta: (n,) rotation [rad].
+        eta: slenderness angle [rad]; enables e_a (Eq. 6, meaningful for free rocking) and the
+            overturning flags.
+        onset_threshold: rotation counted as rocking [rad]; default 1 % of eta, else 1e-3 rad.
+        z: (n,) height of the block's lowest point [m], enables the bouncing entries.
+        z_rest: ground level for ``z`` [m] (default z[0]).
+        bounce_tol: airborne threshold [m] (default that of :func:`bouncing`).
+
+    Returns:
+        dict of scalars; absent measurements are omitted, a never-reached onset is None.
+    """
+    t, th = _history(t, theta, "summarize")
+    out: dict[str, Any] = {
+        "max_rotation_rad": max_rotation(th),
+        "residual_rad": residual_drift(t, th),
+    }
+    thr = onset_threshold if onset_threshold is not None else (0.01 * eta if eta else 1e-3)
+    out["onset_time_s"] = rocking_onset_time(t, th, thr)
+    pk = half_cycle_peaks(t, th)
+    out["half_cycles"] = int(len(pk.value))
+    if eta is not None:
+        out["eta_rad"] = float(eta)
+        out["exceeded_eta"] = bool(max_rotation(th) > eta)
+        out["overturned"] = overturned(th, eta)
+        th0 = abs(float(pk.value[0])) if len(pk.value) else 0.0
+        if len(pk.value) >= 2 and 0.0 < th0 < eta:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                ea = apparent_restitution(pk.value[1:], th0, eta)
+            out["e_a_mean"] = ea.mean
+            out["e_a_first"] = float(ea.per_impact[0])
+    if z is not None:
+        bo = bouncing(t, np.asarray(z, dtype=float), z_rest=z_rest, tol=bounce_tol)
+        out["bounces"] = int(len(bo.magnitude))
+        out["bounce_max_m_s"] = bo.max_magnitude
+    return out
+
+
+def lowest_point_height(ds: Any, block: int) -> NDArray[np.float64] | None:
+    """Height of a block's lowest vertex over time [m], from a rockdem result's geometry.
+
+    Uses ``block_position``, ``block_quaternion`` (w, x, y, z; body -> world), ``vertex_local`` and
+    ``block_vertex_start``; returns None when any of them is missing.
+    """
+    need = ("block_position", "block_quaternion", "vertex_local", "block_vertex_start")
+    if any(name not in ds for name in need):
+        return None
+    start = np.asarray(ds["block_vertex_start"].values, dtype=np.int64)
+    v = np.asarray(ds["vertex_local"].values, dtype=float)[start[block] : start[block + 1]]
+    q = np.asarray(ds["block_quaternion"].values[:, block, :], dtype=float)
+    w, x, y, zq = q.T
+    row_z = np.column_stack((2 * (x * zq - w * y), 2 * (y * zq + w * x), 1 - 2 * (x * x + y * y)))
+    zc = np.asarray(ds["block_position"].values[:, block, 2], dtype=float)
+    return zc + np.min(row_z @ v.T, axis=1)
+
+
+def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = None) -> dict[str, Any]:
+    """:func:`summarize` for one block of a rockdem result (``xarray.Dataset``).
+
+    Args:
+        ds: result with ``time``, ``rocking_angle (time, block)`` [rad] and ``block_free (block)``;
+            optional ``block_eta (block)`` [rad] and the geometry used by
+            :func:`lowest_point_height` (for bouncing).
+        block: block index; default the first free block.
+        eta: slenderness angle [rad]; default ``block_eta[block]`` if present, else no e_a and no
+            overturning flag.
+
+    Raises:
+        ValueError: missing variables, no free block, or a bad block index.
+    """
+    for name in ("time", "rocking_angle", "block_free"):
+        if name not in ds.variables:
+            raise ValueError(f"result has no variable {name!r} (not a rockdem result?)")
+    free = np.asarray(ds["block_free"].values, dtype=bool)
+    if block is None:
+        idx = np.flatnonzero(free)
+        if len(idx) == 0:
+            raise ValueError("result has no free block to summarize")
+        block = int(idx[0])
+    if not (0 <= block < len(free)):
+        raise ValueError(f"block index {block} out of range 0..{len(free) - 1}")
+    if eta is None and "block_eta" in ds.variables:
+        eta = float(ds["block_eta"].values[block])
+    t = np.asarray(ds["time"].values, dtype=float)
+    theta = np.asarray(ds["rocking_angle"].values[:, block], dtype=float)
+    z = lowest_point_height(ds, block)
+    return summarize(t, theta, eta=eta, z=z)

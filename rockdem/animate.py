@@ -1,0 +1,352 @@
+"""Animations of the recorded block motion: GIF (Pillow) or MP4 (ffmpeg).
+
+Blocks are drawn from their geometry and recorded poses (world vertex = R(q) v_local + x), faces
+shaded by a fixed light, driven blocks in grey. Displacements and rotations since t = 0 can be
+magnified. Sub-contacts that failed in tension (orange) or shear (red) are drawn from the contact
+snapshots (``simulate(..., contact_interval=...)``); the failure counts are in every frame's title.
+``view="side"`` draws a 2D side view (projection on the plane normal to the rocking axis) for
+planar rocking; other views are 3D.
+
+The CLI is ``rockdem animate RESULT.nc -o OUT.gif|mp4``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+import xarray as xr
+from matplotlib import colormaps, rc_context
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from .kernels.rotation import axis_angle_matrix, quats_to_matrices, rotation_vector
+from .plots import STYLE, Result, load_result, rocking_direction
+
+__all__ = ["VIEWS", "frame_indices", "posed_vertices", "render_frames", "animate", "register_cli"]
+
+VIEWS: dict[str, tuple[float, float] | None] = {
+    "iso": (20.0, -60.0),
+    "front": (5.0, -90.0),
+    "top": (89.0, -90.0),
+    "side": None,  # 2D projection on the plane normal to the rocking axis
+}
+"""Named viewpoints: (elevation, azimuth) [deg] of the 3D camera, or None for the 2D side view."""
+
+_LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
+_FAIL_COLORS = {1: ("tab:orange", "failed in tension"), 2: ("tab:red", "failed in shear")}
+
+
+def frame_indices(time: np.ndarray, *, fps: float, speed: float, max_frames: int) -> np.ndarray:
+    """Recorded frames to show: one per 1/fps of playback at ``speed`` x real time, at most ``max_frames``."""
+    if fps <= 0 or speed <= 0 or max_frames < 1:
+        raise ValueError("fps, speed and max_frames must be positive; e.g. --fps 20 --speed 1 --max-frames 200")
+    if time.size == 0:
+        raise ValueError("the result has no recorded frame to animate")
+    step = speed / fps
+    span = float(time[-1] - time[0])
+    if span / step + 1 > max_frames:
+        step = span / max(max_frames - 1, 1)
+    targets = np.arange(time[0], time[-1] + 0.5 * step, step) if span > 0 else time[:1]
+    idx = np.clip(np.searchsorted(time, targets), 0, time.size - 1)
+    return np.unique(idx)[:max_frames]
+
+
+def _magnified_rotations(q: np.ndarray, q0: np.ndarray, magnify: float) -> np.ndarray:
+    """R(t) with the rotation since t = 0 scaled by ``magnify``: exp(k rv(R R0^T)) R0, (nb, 3, 3)."""
+    r, r0 = quats_to_matrices(q), quats_to_matrices(q0)
+    if magnify == 1.0:
+        return r
+    rv = rotation_vector(np.einsum("bij,bkj->bik", r, r0)) * magnify
+    out = np.empty_like(r)
+    for b in range(r.shape[0]):
+        ang = float(np.linalg.norm(rv[b]))
+        out[b] = (axis_angle_matrix(rv[b] / ang, ang) if ang > 1e-15 else np.eye(3)) @ r0[b]
+    return out
+
+
+def posed_vertices(ds: xr.Dataset, frame: int, magnify: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """World vertices (nv, 3) [m] at a frame with magnified motion, and the poses used.
+
+    Returns:
+        vertices (nv, 3), rotations (nb, 3, 3), positions (nb, 3).
+    """
+    x0 = ds.block_position.values[0]
+    x = x0 + magnify * (ds.block_position.values[frame] - x0)
+    r = _magnified_rotations(ds.block_quaternion.values[frame], ds.block_quaternion.values[0], magnify)
+    start = ds.block_vertex_start.values
+    owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    v = np.einsum("vij,vj->vi", r[owner], ds.vertex_local.values) + x[owner]
+    return v, r, x
+
+
+def _faces(ds: xr.Dataset) -> tuple[list[np.ndarray], np.ndarray]:
+    """Vertex ids of every face and the block owning it."""
+    fv, fs, bfs = ds.face_vertex.values, ds.face_corner_start.values, ds.block_face_start.values
+    faces = [fv[fs[f] : fs[f + 1]] for f in range(len(fs) - 1)]
+    owner = np.repeat(np.arange(len(bfs) - 1), np.diff(bfs))
+    return faces, owner
+
+
+def _block_colors(ds: xr.Dataset) -> np.ndarray:
+    """RGB (nb, 3): one colour per group for free blocks, grey for driven ones."""
+    groups = [str(g) for g in ds.block_group.values]
+    names = sorted(set(groups))
+    cmap = colormaps["tab10"]
+    col = np.array([cmap(names.index(g) % 10)[:3] for g in groups])
+    col[~ds.block_free.values] = (0.62, 0.62, 0.62)
+    return col
+
+
+def _bounds(ds: xr.Dataset, frames: np.ndarray, magnify: float) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned view box (lo, hi) [m] around the free blocks over the shown frames."""
+    start = ds.block_vertex_start.values
+    owner = np.repeat(np.arange(len(start) - 1), np.diff(start))
+    free = ds.block_free.values[owner] if ds.block_free.values.any() else np.ones(owner.size, bool)
+    pts = np.concatenate([posed_vertices(ds, int(f), magnify)[0][free] for f in frames])
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    pad = 0.15 * float(np.max(hi - lo)) + 1e-3
+    return lo - pad, hi + pad
+
+
+def _snapshot(ds: xr.Dataset, t: float) -> int | None:
+    """Index of the latest contact snapshot at or before time t, or None without snapshots."""
+    if "contact_time" not in ds.coords or ds.sizes["contact_time"] == 0:
+        return None
+    k = int(np.searchsorted(ds.contact_time.values, t + 1e-9, side="right")) - 1
+    return max(k, 0)
+
+
+def _failed_points(ds: xr.Dataset, t: float, r: np.ndarray, x: np.ndarray) -> dict[int, np.ndarray]:
+    """World positions of points failed in tension (1) and shear (2) at time t, on the drawn poses."""
+    k = _snapshot(ds, t)
+    if k is None or "point_local" not in ds:
+        return {}
+    failed = ds.point_failed.values[k]
+    pb = ds.point_block.values
+    out = {}
+    for mode in _FAIL_COLORS:
+        sel = np.flatnonzero(failed == mode)
+        out[mode] = np.einsum("pij,pj->pi", r[pb[sel]], ds.point_local.values[sel]) + x[pb[sel]]
+    return out
+
+
+def _title(ds: xr.Dataset, frame: int, magnify: float) -> str:
+    t = float(ds.time.values[frame])
+    text = f"t = {t:.2f} s"
+    if magnify != 1.0:
+        text += f", motion x{magnify:g}"
+    ften, fsh = int(ds.contacts_failed_tension.values[frame]), int(ds.contacts_failed_shear.values[frame])
+    if ften or fsh:
+        text += f"; failed: {ften} tension, {fsh} shear"
+    return text
+
+
+def _draw_3d(ax, ds, frame, magnify, view, lo, hi, faces, owner, colors) -> None:  # type: ignore[no-untyped-def]
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    v, r, x = posed_vertices(ds, frame, magnify)
+    free_v = np.repeat(ds.block_free.values, np.diff(ds.block_vertex_start.values))
+    v = np.where(free_v[:, None], v, np.clip(v, lo, hi))  # cut the (large) foundation to the view box
+    polys, shades = [], []
+    for f, ids in enumerate(faces):
+        p = v[ids]
+        n = np.cross(p[1] - p[0], p[2] - p[0])
+        n = n / (np.linalg.norm(n) + 1e-300)
+        polys.append(p)
+        shades.append(colors[owner[f]] * (0.45 + 0.55 * max(0.0, float(n @ _LIGHT))))
+    ax.computed_zorder = False  # failed points stay visible in front of the faces (x-ray overlay)
+    ax.add_collection3d(Poly3DCollection(polys, facecolors=shades, edgecolors="k", linewidths=0.3, zorder=1))
+    for mode, pts in _failed_points(ds, float(ds.time.values[frame]), r, x).items():
+        if len(pts):
+            c, lab = _FAIL_COLORS[mode]
+            ax.scatter(pts[:, 0], pts[:, 1], pts[:, 2], color=c, s=10, depthshade=False, label=lab, zorder=3)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(hi - lo)
+    ax.view_init(elev=view[0], azim=view[1])
+    ax.set_proj_type("ortho")
+    ax.locator_params(nbins=4)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+
+
+def _draw_side(ax, ds, frame, magnify, lo, hi, colors) -> None:  # type: ignore[no-untyped-def]
+    from matplotlib.patches import Polygon
+    from scipy.spatial import ConvexHull
+
+    d = rocking_direction(ds)
+    up = np.cross(d, np.asarray(ds.attrs.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float))
+    v, r, x = posed_vertices(ds, frame, magnify)
+    start = ds.block_vertex_start.values
+    for b in range(len(start) - 1):
+        p2 = np.stack([v[start[b] : start[b + 1]] @ d, v[start[b] : start[b + 1]] @ up], axis=1)
+        hull = p2[ConvexHull(p2).vertices]  # a convex block projects onto the hull of its vertices
+        ax.add_patch(Polygon(hull, closed=True, facecolor=colors[b], edgecolor="k", lw=0.5))
+    for mode, pts in _failed_points(ds, float(ds.time.values[frame]), r, x).items():
+        if len(pts):
+            c, lab = _FAIL_COLORS[mode]
+            ax.plot(pts @ d, pts @ up, "o", color=c, ms=3, label=lab)
+    corners = np.array([[lo[0], lo[1], lo[2]], [hi[0], hi[1], hi[2]]])
+    h = np.sort(np.stack([corners @ d, corners @ up], axis=1), axis=0)
+    ax.set_xlim(h[0, 0], h[1, 0])
+    ax.set_ylim(h[0, 1], h[1, 1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("horizontal, rocking direction [m]")
+    ax.set_ylabel("vertical [m]")
+
+
+def render_frames(
+    result: Result,
+    *,
+    view: str | tuple[float, float] = "iso",
+    magnify: float = 1.0,
+    fps: float = 20.0,
+    speed: float = 1.0,
+    max_frames: int = 200,
+    size: tuple[float, float] = (6.0, 4.5),
+    dpi: float = 80.0,
+) -> list[np.ndarray]:
+    """Render the shown frames as RGB images (H, W, 3) uint8.
+
+    Args:
+        result: a result or its NetCDF path.
+        view: a name of :data:`VIEWS` or (elevation, azimuth) [deg].
+        magnify: factor on displacements and rotations since t = 0 [-].
+        fps: frames per second of playback; speed: simulated seconds per playback second.
+        max_frames: cap on the number of frames (the stride grows to fit).
+        size: figure size [in]; dpi: pixels per inch.
+    """
+    ds = load_result(result)
+    if isinstance(view, str):
+        if view not in VIEWS:
+            raise ValueError(f"view {view!r} unknown; use one of {sorted(VIEWS)} or (elevation, azimuth) in degrees")
+        cam = VIEWS[view]
+    else:
+        cam = (float(view[0]), float(view[1]))
+    if not (np.isfinite(magnify) and magnify > 0):
+        raise ValueError(f"magnify must be a positive factor, got {magnify!r}")
+    frames = frame_indices(ds.time.values, fps=fps, speed=speed, max_frames=max_frames)
+    lo, hi = _bounds(ds, frames, magnify)
+    faces, owner = _faces(ds)
+    colors = _block_colors(ds)
+    images = []
+    with rc_context(STYLE):
+        for f in frames:
+            fig = Figure(figsize=size, dpi=dpi)
+            canvas = FigureCanvasAgg(fig)
+            if cam is None:
+                ax = fig.add_subplot()
+                _draw_side(ax, ds, int(f), magnify, lo, hi, colors)
+            else:
+                ax = fig.add_subplot(projection="3d")
+                _draw_3d(ax, ds, int(f), magnify, cam, lo, hi, faces, owner, colors)
+            ax.set_title(_title(ds, int(f), magnify))
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(loc="upper right", fontsize=7)
+            canvas.draw()
+            images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
+    return images
+
+
+def _ffmpeg() -> str:
+    exe = shutil.which("ffmpeg")
+    if exe is None:
+        raise ValueError(
+            "output .mp4 needs the ffmpeg program, which is not on PATH; install ffmpeg "
+            "(e.g. apt-get install ffmpeg or conda install ffmpeg) or write a .gif instead"
+        )
+    return exe
+
+
+def _write_gif(images: Sequence[np.ndarray], path: Path, fps: float) -> None:
+    from PIL import Image
+
+    frames = [Image.fromarray(im).convert("P", palette=Image.Palette.ADAPTIVE, colors=255) for im in images]
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=round(1000.0 / fps), loop=0)
+
+
+def _write_mp4(images: Sequence[np.ndarray], path: Path, fps: float, exe: str) -> None:
+    h, w = images[0].shape[:2]
+    cmd = [
+        exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", f"{fps:g}",
+        "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-vcodec", "libx264", str(path),
+    ]
+    proc = subprocess.run(cmd, input=b"".join(im.tobytes() for im in images), capture_output=True)
+    if proc.returncode != 0:
+        raise ValueError(f"ffmpeg failed writing {path}: {proc.stderr.decode(errors='replace').strip()}")
+
+
+def animate(result: Result, path: str | Path, *, fps: float = 20.0, **options: object) -> Path:
+    """Write an animation of the blocks' motion to ``path`` (.gif, or .mp4 when ffmpeg is present).
+
+    Args:
+        result: a result or its NetCDF path.
+        path: output file; the suffix chooses the format.
+        fps: frames per second of playback.
+        **options: passed to :func:`render_frames` (view, magnify, speed, max_frames, size, dpi).
+
+    Returns:
+        The path written.
+    """
+    p = Path(path)
+    suffix = p.suffix.lower()
+    if suffix not in (".gif", ".mp4"):
+        raise ValueError(f"output {p}: the suffix must be .gif or .mp4")
+    exe = _ffmpeg() if suffix == ".mp4" else ""  # fail before rendering
+    images = render_frames(result, fps=fps, **options)  # type: ignore[arg-type]
+    p.parent.mkdir(parents=True, exist_ok=True)
+    if suffix == ".gif":
+        _write_gif(images, p, fps)
+    else:
+        _write_mp4(images, p, fps, exe)
+    return p
+
+
+def _view_arg(text: str) -> str | tuple[float, float]:
+    if text in VIEWS:
+        return text
+    try:
+        elev, azim = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--view: one of {sorted(VIEWS)} or ELEV,AZIM in degrees") from None
+    return elev, azim
+
+
+def _animate(args: argparse.Namespace) -> int:
+    out = Path(args.output) if args.output else Path(args.result).with_suffix(".gif")
+    w, h = args.size
+    p = animate(
+        args.result,
+        out,
+        fps=args.fps,
+        view=args.view,
+        magnify=args.magnify,
+        speed=args.speed,
+        max_frames=args.max_frames,
+        size=(w / args.dpi, h / args.dpi),
+        dpi=args.dpi,
+    )
+    print(f"rockdem animate: wrote {p}")
+    return 0
+
+
+def register_cli(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``animate`` sub-command."""
+    p = subparsers.add_parser("animate", help="animate the blocks of a result (GIF, MP4 with ffmpeg)")
+    p.add_argument("result", metavar="RESULT.nc")
+    p.add_argument("-o", "--output", help="output .gif or .mp4 (default RESULT.gif)")
+    p.add_argument("--view", type=_view_arg, default="iso", help=f"{', '.join(VIEWS)} or ELEV,AZIM [deg] (default iso)")
+    p.add_argument("--magnify", type=float, default=1.0, help="factor on displacements and rotations (default 1)")
+    p.add_argument("--fps", type=float, default=20.0, help="frames per second (default 20)")
+    p.add_argument("--speed", type=float, default=1.0, help="simulated seconds per playback second (default 1)")
+    p.add_argument("--max-frames", type=int, default=200, help="most frames (default 200)")
+    p.add_argument("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (default 480 360)")
+    p.add_argument("--dpi", type=float, default=80.0, help="pixels per inch of the text (default 80)")
+    p.set_defaults(func=_animate)

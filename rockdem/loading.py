@@ -1,0 +1,456 @@
+"""Earthquake loading and quasi-static pushover (DESIGN §2 "Loading"; paper §3.3 and §4).
+
+Earthquakes can be applied in two equivalent frames:
+
+* ``mode="foundation"`` (absolute frame, as 3DEC does): the record's ground velocity v_g(t)
+  (trapezoid integral of the acceleration from rest, optionally baseline corrected) becomes the
+  velocity history of every block added with ``driven="ground"`` (foundation, return walls, rods).
+* ``mode="inertial"`` (relative frame): the foundation stays fixed and every free block carries the
+  d'Alembert body force -m a_g(t).
+
+For a rigid foundation both give the same *relative* motion (tested in ``tests/test_loading.py``):
+contact forces and stiffness-proportional (SP) dashpots depend on relative displacements and
+velocities only. Mass-proportional (MP) damping does not: with absolute velocities (the default,
+as in 3DEC) it acts on v = v_rel + v_g in foundation mode but on v_rel in inertial mode, so the
+same alpha damps differently. Prefer
+
+* foundation mode to reproduce 3DEC runs with absolute MP damping, to shake several ground-attached
+  blocks (return walls, restraining rods) and to apply vertical motion of the supports;
+* inertial mode (or foundation mode with ``Damping(alpha_relative=True)``) for MP damping that
+  does not resist the rigid-body motion of the ground, and for the smallest drift of the model in
+  space (no baseline correction needed: the acceleration is applied as read).
+
+Quasi-static pushover (paper §3.3, Fig. 9A): a lateral body acceleration lambda(t) g d on every free
+block, lambda ramped linearly at ``rate`` [1/s] up to ``max_load_factor`` and held, with Cundall's
+local damping (0.8) so that the response stays quasi-static. Load control traces the capacity
+curve up to its peak only: past the peak the block topples.
+
+Units: SI (m, s, m/s^2); records are converted once by :mod:`rockdem.records`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike, NDArray
+
+from .case import Table, loading
+from .model import GROUND, Damping, ModelBuilder, Motion
+from .records import STANDARD_GRAVITY, GroundMotion, read_record, shared_record_path
+from .simulate import Monitor, simulate
+
+__all__ = [
+    "EARTHQUAKE_MODES",
+    "EarthquakeInput",
+    "PushoverRamp",
+    "resolve_record",
+    "prepare_record",
+    "apply_earthquake",
+    "apply_pushover",
+    "pushover",
+    "capacity_curve",
+]
+
+EARTHQUAKE_MODES = ("foundation", "inertial")
+"""How a record is applied: driven ground blocks (absolute frame) or inertial body forces."""
+
+
+@dataclass(frozen=True)
+class EarthquakeInput:
+    """What :func:`apply_earthquake` put on the builder.
+
+    Attributes:
+        mode: "foundation" or "inertial".
+        time: (n,) simulation times of the samples [s] (the record starts at ``delay``).
+        acceleration: (n, 3) ground acceleration [m/s^2] (after scaling and correction).
+        velocity: (n, 3) ground velocity [m/s], zero at t = 0 (the model starts from rest).
+        motion: the processed record.
+    """
+
+    mode: str
+    time: NDArray[np.float64]
+    acceleration: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    motion: GroundMotion
+
+    @property
+    def pga(self) -> float:
+        """Peak horizontal ground acceleration of the applied input [m/s^2]."""
+        return float(np.max(np.linalg.norm(self.acceleration[:, :2], axis=1)))
+
+
+def resolve_record(name: str | Path) -> Path:
+    """Find a record file: an absolute path as is, a path existing relative to the working folder
+    as is, else a file of that name in the shared ground-motion folder
+    (:func:`rockdem.records.shared_record_path`)."""
+    p = Path(name).expanduser()
+    if p.is_absolute() or p.exists():
+        if not p.exists():
+            raise FileNotFoundError(f"record file {p} does not exist")
+        return p
+    return shared_record_path(str(name))
+
+
+def prepare_record(
+    motion: GroundMotion,
+    *,
+    scale: float = 1.0,
+    pga: float | None = None,
+    direction: ArrayLike | None = None,
+    vertical: bool = False,
+    baseline: bool = True,
+    tail: float = 0.0,
+    window: tuple[float, float] | None = None,
+) -> GroundMotion:
+    """Process a record for application: window, scale (or scale to ``pga`` [m/s^2]), direction,
+    baseline correction (linear velocity trend removed) and a free-vibration tail [s].
+
+    The windowed record restarts from rest at the window start. At least one zero-acceleration
+    sample is appended so that the held end value of the input tables is "no acceleration".
+    """
+    gm = motion
+    if window is not None:
+        t0, t1 = float(window[0]), float(window[1])
+        if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
+            raise ValueError(f"{gm.name}: window must be (start, end) with end > start [s], got {window!r}")
+        keep = (gm.time >= t0 - 1e-9 * gm.dt) & (gm.time <= t1 + 1e-9 * gm.dt)
+        if keep.sum() < 2:
+            raise ValueError(f"{gm.name}: window {window!r} holds fewer than two samples "
+                             f"(record spans {gm.time[0]:g}..{gm.time[-1]:g} s)")
+        vert = None if gm.vertical is None else gm.vertical[keep]
+        gm = replace(gm, acceleration=gm.acceleration[keep], vertical=vert, start_time=float(gm.time[keep][0]))
+    if not vertical and gm.vertical is not None:
+        gm = replace(gm, vertical=None)
+    if vertical and gm.vertical is None:
+        raise ValueError(f"{gm.name}: vertical=True but the record has no vertical component")
+    if direction is not None:
+        gm = gm.with_direction(direction)
+    if not (math.isfinite(scale) and scale >= 0.0):
+        raise ValueError(f"{gm.name}: scale must be a finite factor >= 0, got {scale!r}")
+    gm = gm.scaled_to_pga(pga) if pga is not None else gm.scaled(scale)
+    if baseline:
+        gm = gm.baseline_corrected(1)
+    if not (math.isfinite(tail) and tail >= 0.0):
+        raise ValueError(f"{gm.name}: tail must be >= 0 s, got {tail!r}")
+    return gm.with_tail(max(tail, gm.dt))
+
+
+def apply_earthquake(
+    builder: ModelBuilder,
+    motion: GroundMotion,
+    *,
+    mode: str = "foundation",
+    scale: float = 1.0,
+    pga: float | None = None,
+    direction: ArrayLike | None = None,
+    vertical: bool = False,
+    baseline: bool = True,
+    tail: float = 0.0,
+    window: tuple[float, float] | None = None,
+    delay: float = 0.0,
+    substeps: int = 16,
+) -> EarthquakeInput:
+    """Apply an earthquake record to a model being built.
+
+    Args:
+        builder: the model builder (ground-attached blocks added with ``driven="ground"``).
+        motion: the record, in SI (from :func:`rockdem.records.read_record`).
+        mode: "foundation": ground velocity history on the ``driven="ground"`` blocks
+            (absolute frame); "inertial": body acceleration -a_g(t) on the free blocks, foundation
+            fixed (relative frame). See the module docstring for MP damping, which differs.
+        scale: factor on the accelerations [-] (ignored when ``pga`` is given).
+        pga: scale the record to this horizontal PGA [m/s^2] instead.
+        direction: horizontal direction (3,) of the record; default the record's own (+x).
+        vertical: apply the record's vertical component too (it must have one).
+        baseline: remove the linear trend of the ground velocity (foundation ends near rest).
+        tail: free-vibration time after the record [s].
+        window: (start, end) part of the record to use [s of the record]; restarts from rest.
+        delay: time at rest before the record starts [s] (lets the model settle under gravity).
+        substeps: foundation mode: velocity samples per record interval. The engine interpolates
+            the driven velocity linearly, whereas the exact integral of a linearly interpolated
+            acceleration is quadratic; sub-sampling it makes the two modes agree to O(1/substeps^2).
+
+    Returns:
+        The applied input (times, accelerations, velocities).
+    """
+    if mode not in EARTHQUAKE_MODES:
+        raise ValueError(f"earthquake mode must be one of {list(EARTHQUAKE_MODES)}, got {mode!r}")
+    if not (math.isfinite(delay) and delay >= 0.0):
+        raise ValueError(f"earthquake delay must be >= 0 s, got {delay!r}")
+    gm = prepare_record(motion, scale=scale, pga=pga, direction=direction, vertical=vertical,
+                        baseline=baseline, tail=tail, window=window)
+    acc = gm.vector_acceleration()
+    vel = gm.vector_velocity()  # from rest: v(t_0) = 0
+    t = delay + gm.dt * np.arange(gm.npts)
+    if delay > 0.0:  # at rest until the record starts
+        t = np.r_[0.0, t]
+        acc = np.vstack([np.zeros((1, 3)), acc])
+        vel = np.vstack([np.zeros((1, 3)), vel])
+    if mode == "foundation":
+        if builder.ground_motion is not None:
+            raise ValueError("the builder already has a ground motion; apply one earthquake per model")
+        if not _has_ground_blocks(builder):
+            raise ValueError("foundation mode moves the blocks added with driven='ground', and this model "
+                             "has none; add the foundation with driven='ground' or use mode='inertial'")
+        builder.set_ground_motion(Motion(*_velocity_table(t, acc, vel, substeps)))
+    else:
+        if builder.body_acceleration is not None:
+            raise ValueError("the builder already has a body acceleration (another loading); "
+                             "inertial mode needs it for -a_g(t)")
+        builder.set_body_acceleration(t, -acc)
+    return EarthquakeInput(mode, t, acc, vel, gm)
+
+
+def _velocity_table(
+    t: NDArray[np.float64], acc: NDArray[np.float64], vel: NDArray[np.float64], substeps: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Velocity sampled ``substeps`` times per interval, exact for piecewise-linear acceleration."""
+    if int(substeps) != substeps or substeps < 1:
+        raise ValueError(f"substeps must be an integer >= 1, got {substeps!r}")
+    m = int(substeps)
+    if m == 1:
+        return t, vel
+    h = np.diff(t)[:, None]  # (n-1, 1)
+    s = (np.arange(m) / m)[None, :]  # fraction of the interval
+    tt = (t[:-1, None] + s * h).reshape(-1)
+    # v(t_k + s h) = v_k + h (a_k s + (a_{k+1} - a_k) s^2 / 2)
+    da = acc[1:] - acc[:-1]
+    vv = vel[:-1, None, :] + h[:, :, None] * (acc[:-1, None, :] * s[:, :, None] + 0.5 * da[:, None, :] * s[:, :, None] ** 2)
+    return np.r_[tt, t[-1]], np.vstack([vv.reshape(-1, 3), vel[-1:]])
+
+
+def _has_ground_blocks(builder: ModelBuilder) -> bool:
+    # ModelBuilder has no public query for this yet (see docs/loading.md, engine requests).
+    blocks = getattr(builder, "_blocks", None)
+    return True if blocks is None else any(getattr(b, "driven", None) == GROUND for b in blocks)
+
+
+# -- pushover --------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PushoverRamp:
+    """A linear load-factor ramp lambda(t) = min(rate t, max_load_factor).
+
+    Attributes:
+        rate: d lambda / dt [1/s].
+        max_load_factor: the held final value [-].
+        direction: (3,) horizontal unit vector of the load.
+        gravity: |g| [m/s^2]; the body acceleration is lambda(t) g direction.
+    """
+
+    rate: float
+    max_load_factor: float
+    direction: NDArray[np.float64]
+    gravity: float
+
+    @property
+    def ramp_time(self) -> float:
+        """Time to reach ``max_load_factor`` [s]."""
+        return self.max_load_factor / self.rate
+
+    def load_factor(self, time: ArrayLike) -> NDArray[np.float64]:
+        """lambda at ``time`` (array) [s]."""
+        return np.minimum(self.rate * np.asarray(time, dtype=float), self.max_load_factor)
+
+    def attrs(self) -> dict[str, Any]:
+        """The ramp as result attributes (read back by :func:`capacity_curve`)."""
+        return {
+            "pushover_rate": self.rate,
+            "pushover_max_load_factor": self.max_load_factor,
+            "pushover_direction": self.direction.tolist(),
+            "pushover_gravity": self.gravity,
+        }
+
+
+def apply_pushover(
+    builder: ModelBuilder, *, rate: float, max_load_factor: float, direction: ArrayLike = (1.0, 0.0, 0.0)
+) -> PushoverRamp:
+    """Put the pushover body acceleration lambda(t) |g| d on every free block of ``builder``.
+
+    Args:
+        rate: load-factor rate [1/s]; slow enough for a quasi-static response (ramp time much
+            longer than the elastic rocking period, e.g. > 50 periods).
+        max_load_factor: final lambda [-] (held after the ramp); for a rigid block the capacity is B/H.
+        direction: horizontal load direction (3,), normalised here.
+    """
+    if not (math.isfinite(rate) and rate > 0.0):
+        raise ValueError(f"pushover rate must be a positive load-factor rate [1/s], got {rate!r}")
+    if not (math.isfinite(max_load_factor) and max_load_factor > 0.0):
+        raise ValueError(f"pushover max_load_factor must be positive, got {max_load_factor!r}")
+    d = _horizontal_unit(direction, builder.gravity, "pushover direction")
+    if builder.body_acceleration is not None:
+        raise ValueError("the builder already has a body acceleration (another loading)")
+    g = float(np.linalg.norm(builder.gravity)) or STANDARD_GRAVITY
+    ramp = PushoverRamp(float(rate), float(max_load_factor), d, g)
+    t_end = ramp.ramp_time
+    builder.set_body_acceleration([0.0, t_end], [np.zeros(3), max_load_factor * g * d])
+    return ramp
+
+
+def pushover(
+    builder: ModelBuilder,
+    *,
+    rate: float,
+    max_load_factor: float,
+    direction: ArrayLike = (1.0, 0.0, 0.0),
+    local_damping: float = 0.8,
+    damping: Damping | None = None,
+    monitors: Mapping[str, Monitor] | None = None,
+    duration: float | None = None,
+    record_interval: float | None = None,
+    **simulate_kwargs: Any,
+) -> xr.Dataset:
+    """Run a load-controlled quasi-static pushover (paper §3.3, Fig. 9A).
+
+    Applies :func:`apply_pushover`, finalizes with Cundall local damping ``local_damping`` (added to
+    ``damping`` if given), runs until the ramp ends (or ``duration`` [s]) and stores the ramp in the
+    result's attributes for :func:`capacity_curve`.
+
+    Returns:
+        The result Dataset (attrs ``pushover_*``).
+    """
+    ramp = apply_pushover(builder, rate=rate, max_load_factor=max_load_factor, direction=direction)
+    base = Damping() if damping is None else damping
+    model = builder.finalize(damping=replace(base, local=local_damping))
+    duration = ramp.ramp_time if duration is None else duration
+    if record_interval is None:
+        record_interval = duration / 500.0
+    ds = simulate(model, duration, monitors=monitors, record_interval=record_interval, **simulate_kwargs)
+    ds.attrs.update(ramp.attrs())
+    return ds
+
+
+def capacity_curve(
+    ds: xr.Dataset,
+    monitor: str = "top",
+    direction: ArrayLike | None = None,
+    *,
+    source: str = "auto",
+    rate: float | None = None,
+    max_load_factor: float | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Capacity curve of a pushover result: load factor lambda vs monitor displacement.
+
+    Args:
+        ds: a result of :func:`pushover` or of a case with ``[loading] type = "pushover"``.
+        monitor: monitor point name (default "top").
+        direction: displacement component (3,); default the load direction (else +x).
+        source: "ramp": lambda(t) of the applied ramp (from the attrs or ``rate`` and
+            ``max_load_factor``); "reaction": lambda = -R.d / (W) from the base reaction R and the
+            weight W of the free blocks (quasi-static equilibrium; includes inertia after the peak);
+            "auto": the ramp when known, else the reaction.
+
+    Returns:
+        (load_factor (T,) [-], displacement (T,) [m]).
+    """
+    if source not in ("auto", "ramp", "reaction"):
+        raise ValueError(f"source must be 'auto', 'ramp' or 'reaction', got {source!r}")
+    a = ds.attrs
+    rate = a.get("pushover_rate") if rate is None else rate
+    lam_max = a.get("pushover_max_load_factor") if max_load_factor is None else max_load_factor
+    if direction is None:
+        direction = a.get("pushover_direction", (1.0, 0.0, 0.0))
+    d = np.asarray(direction, dtype=float).reshape(3)
+    d = d / np.linalg.norm(d)
+    names = [str(n) for n in ds.monitor.values]
+    if monitor not in names:
+        raise KeyError(f"no monitor {monitor!r} in the result; monitors are {names}")
+    disp = ds.monitor_displacement.values[:, names.index(monitor), :] @ d
+    if source == "ramp" or (source == "auto" and rate is not None):
+        if rate is None or lam_max is None:
+            raise ValueError("the ramp is unknown: pass rate and max_load_factor, or use source='reaction'")
+        lam = np.minimum(float(rate) * ds.time.values, float(lam_max))
+    else:
+        g = float(a.get("pushover_gravity", np.linalg.norm(a.get("gravity", (0.0, 0.0, -STANDARD_GRAVITY)))))
+        weight = float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum()) * g
+        lam = -(ds.base_reaction.values @ d) / weight
+    return lam, disp
+
+
+def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: str) -> NDArray[np.float64]:
+    d = np.asarray(direction, dtype=float).reshape(3)
+    gn = float(np.linalg.norm(gravity))
+    if gn > 0:
+        up = -gravity / gn
+        d = d - up * (up @ d)
+    n = float(np.linalg.norm(d))
+    if not (math.isfinite(n) and n > 0):
+        raise ValueError(f"{what} must be a finite vector with a horizontal component, got {direction!r}")
+    return d / n
+
+
+# -- TOML loading types ------------------------------------------------------------------------
+
+
+def _read_table_record(t: Table, key: str, units: str | None, dt: float | None) -> GroundMotion:
+    name = t.string(key)
+    return read_record(resolve_record(name), units=units, dt=dt)
+
+
+@loading("earthquake")
+def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
+    """An earthquake record on the foundation (or as inertial forces), starting from rest.
+
+    Keys: record (file path, or a file name in the shared ground-motion folder), units ("g",
+    "m/s2", "cm/s2"; optional for AT2), dt [s] (single-column files), scale (default 1) or pga_g
+    (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
+    the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
+    baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0).
+    """
+    units = t.raw("units")
+    if units is not None and not isinstance(units, str):
+        raise ValueError(f"[{t.where}] units must be a string such as \"g\", got {units!r}")
+    dt = t.optional_number("dt", positive=True)
+    gm = _read_table_record(t, "record", units, dt)
+    vert = t.raw("vertical", False)
+    if isinstance(vert, str):
+        gv = read_record(resolve_record(vert), units=units, dt=dt)
+        n = min(gv.npts, gm.npts)
+        if abs(gv.dt - gm.dt) > 1e-9 * gm.dt:
+            raise ValueError(f"[{t.where}] vertical record dt {gv.dt} s differs from the record's {gm.dt} s")
+        gm = replace(gm, acceleration=gm.acceleration[:n], vertical=gv.acceleration[:n])
+    elif vert is not False:
+        raise ValueError(f"[{t.where}] vertical must be false or a record file of the vertical component, got {vert!r}")
+    scale = t.number("scale", 1.0, min_=0.0)
+    pga_g = t.optional_number("pga_g", positive=True)
+    if pga_g is not None and "scale" in t.data:
+        raise ValueError(f"[{t.where}] give scale or pga_g, not both")
+    window = t.raw("window")
+    if window is not None:
+        window = tuple(t.vector("window", size=2))
+    info = apply_earthquake(
+        b,
+        gm,
+        mode=t.string("mode", "foundation", choices=EARTHQUAKE_MODES),
+        scale=scale,
+        pga=None if pga_g is None else pga_g * STANDARD_GRAVITY,
+        direction=t.vector("direction", (1.0, 0.0, 0.0)),
+        vertical=isinstance(vert, str),
+        baseline=t.boolean("baseline", True),
+        tail=t.number("tail", 0.0, min_=0.0),
+        window=window,  # type: ignore[arg-type]
+        delay=t.number("delay", 0.0, min_=0.0),
+    )
+    ctx["earthquake"] = info
+
+
+@loading("pushover")
+def _pushover(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
+    """Quasi-static pushover: lateral body acceleration lambda(t) g d, lambda = min(rate t, max).
+
+    Keys: rate [1/s] (default 0.1), max_load_factor (required), direction (default [1, 0, 0]).
+    Set ``[damping] local = 0.8`` for a quasi-static response (Cundall's local damping).
+    """
+    ramp = apply_pushover(
+        b,
+        rate=t.number("rate", 0.1, positive=True),
+        max_load_factor=t.number("max_load_factor", positive=True),
+        direction=t.vector("direction", (1.0, 0.0, 0.0)),
+    )
+    ctx["pushover"] = ramp

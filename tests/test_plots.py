@@ -1,0 +1,117 @@
+"""Tests of rockdem.plots: every plot kind on the built-in example and on a discretised wall,
+the kinematics behind the plotted quantities, WME in the comparison legend, and an image
+regression of two figures against stored baselines.
+
+Baselines: tests/baseline/*.png, drawn from an engine-independent synthetic result with the fixed
+style of rockdem.plots.STYLE; regenerate with ``ROCKDEM_UPDATE_BASELINES=1 pytest tests/test_plots.py``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.testing.compare import compare_images
+from PIL import Image
+
+from rockdem.cli import main
+from rockdem.plots import (
+    PLOTS,
+    block_dimensions,
+    plot_comparison,
+    plot_history,
+    plot_restitution,
+    save_figure,
+    top_displacement,
+)
+from rockdem.results import save
+from viz_cases import example_result, synthetic_result, wall_result
+
+BASELINE = Path(__file__).parent / "baseline"
+
+
+@pytest.fixture(scope="module")
+def result_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    d = tmp_path_factory.mktemp("results")
+    return {"example": save(example_result(), d / "example.nc"), "wall": save(wall_result(), d / "wall.nc")}
+
+
+def _nonempty_image(path: Path) -> None:
+    assert path.stat().st_size > 1000
+    with Image.open(path) as im:
+        pixels = np.asarray(im.convert("L"), dtype=float)
+    assert pixels.std() > 5.0  # something is drawn, not a blank canvas
+
+
+@pytest.mark.parametrize("which", ["example", "wall"])
+@pytest.mark.parametrize("kind", sorted(PLOTS))
+def test_every_plot_command_writes_an_image(result_files, tmp_path, kind, which):
+    out = tmp_path / f"{which}_{kind}.png"
+    assert main(["plot", str(result_files[which]), "--kind", kind, "-o", str(out), "--dpi", "50"]) == 0
+    _nonempty_image(out)
+
+
+def test_plot_all_kinds_as_pdf_next_to_the_result(result_files):
+    assert main(["plot", str(result_files["example"]), "--kind", "all", "--format", "pdf"]) == 0
+    for kind in PLOTS:
+        p = result_files["example"].with_name(f"example_{kind}.pdf")
+        assert p.read_bytes()[:5] == b"%PDF-"
+
+
+def test_block_dimensions_are_the_untilted_width_and_height():
+    # The example block is 0.2 m wide and 2 m high, tilted to 0.9 eta: B and H must not see the tilt.
+    b, h = block_dimensions(example_result(), "block")
+    assert b == pytest.approx(0.2, abs=1e-9)
+    assert h == pytest.approx(2.0, abs=1e-9)
+
+
+def test_top_displacement_at_release_is_h_sin_theta0():
+    # Rigid rotation by theta0 about the base corner moves the top of the pivot side by H sin(theta0).
+    ds = example_result()
+    u, _ = top_displacement(ds)
+    theta0 = float(ds.rocking_angle.values[0, 1])
+    assert theta0 == pytest.approx(0.9 * np.arctan(0.2 / 2.0), rel=1e-9)
+    assert u[0] == pytest.approx(2.0 * np.sin(theta0), rel=1e-6)
+
+
+def test_comparison_legend_gives_wme_against_the_measured_history(tmp_path):
+    ds = example_result()
+    u, _ = top_displacement(ds)
+    csv = tmp_path / "measured.csv"
+    np.savetxt(csv, np.column_stack([ds.time.values, u / 0.2]), delimiter=",", header="time [s],u/B [-]")
+    fig = plot_comparison([ds, ds], labels=["same", "same again"], measured=csv)
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert texts[0].startswith("measured")
+    assert "WME = 0.000" in texts[1]
+    # Half the amplitude: sum|x - x/2||x| / sum x^2 = 0.5 exactly.
+    half = (ds.time.values, 2.0 * u / 0.2)
+    fig = plot_comparison(ds, labels=["sim"], measured=half)
+    assert "WME = 0.500" in fig.axes[0].get_legend().get_texts()[1].get_text()
+
+
+def test_errors_name_the_field_and_the_fix(tmp_path):
+    ds = example_result()
+    with pytest.raises(ValueError, match="block 'nope'.*give one of"):
+        plot_history(ds, block="nope")
+    with pytest.raises(ValueError, match="monitor 'nope'"):
+        plot_history(ds, monitor="nope")
+    bad = tmp_path / "one_column.csv"
+    bad.write_text("1\n2\n3\n")
+    with pytest.raises(ValueError, match="two numeric columns"):
+        plot_comparison(ds, measured=bad)
+    with pytest.raises(ValueError, match=r"\.png or \.pdf"):
+        save_figure(plot_history(ds), tmp_path / "x.jpg")
+
+
+@pytest.mark.parametrize("name, func", [("history", plot_history), ("restitution", plot_restitution)])
+def test_image_matches_baseline(tmp_path, name, func):
+    actual = save_figure(func(synthetic_result()), tmp_path / f"{name}.png", dpi=60)
+    expected = BASELINE / f"{name}.png"
+    if os.environ.get("ROCKDEM_UPDATE_BASELINES"):
+        BASELINE.mkdir(exist_ok=True)
+        expected.write_bytes(actual.read_bytes())
+    assert expected.exists(), f"missing baseline {expected}; run with ROCKDEM_UPDATE_BASELINES=1"
+    # RMS tolerance on 0-255 pixel values: absorbs anti-aliasing and FreeType differences only.
+    assert compare_images(str(expected), str(actual), tol=3.0) is None

@@ -1,0 +1,191 @@
+"""Specimen builders: geometry, mass, bonded joints, short physics checks and the TOML forms."""
+
+import math
+
+import numpy as np
+import pytest
+
+from rockdem.case import parse_case
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, ModelBuilder
+from rockdem.simulate import simulate
+from rockdem.specimens import brick_wall, facade, parapet, stacked_blocks, two_block_wall
+from rockdem.state import initial_state
+
+MORTAR = JointMaterial.from_modulus(1.8e9, 0.076, friction_angle=31.0, cohesion=0.5e6, tension=0.3e6)
+
+
+def _bottom_width(poly) -> float:
+    """x-width of the lowest face of a polyhedron [m]."""
+    k = int(np.argmin(poly.normals[:, 2]))
+    return float(np.ptp(poly.vertices[poly.faces[k], 0]))
+
+
+@pytest.mark.parametrize("bond,count", [("running", 3 * 3 + 2 * 4), ("stack", 5 * 3)])
+def test_wall_counts_mass_no_overlap_and_bonded_joints(bond, count):
+    bld = ModelBuilder()
+    brick = (0.11, 0.23, 0.076)
+    brick_wall(bld, brick=brick, courses=5, bricks_per_course=3, bond=bond, joint=MORTAR, base=JointMaterial(kn=2e10))
+    model = bld.finalize()
+    free = model.arrays.block_free
+    assert int(free.sum()) == count
+    # mass = density x wall volume (the half bricks fill the running-bond ends exactly)
+    volume = 0.11 * (3 * 0.23) * (5 * 0.076)
+    assert model.arrays.block_mass[free].sum() == pytest.approx(1800.0 * volume, rel=1e-9)
+    state, _ = initial_state(model)  # raises on overlap
+    a = model.arrays
+    brick_g = model.group_names.index("brick")
+    pts = np.flatnonzero(state.point_partner >= 0)
+    owner_g, partner_g = a.block_group[a.point_block[pts]], a.block_group[state.point_partner[pts]]
+    joint = (owner_g == brick_g) & (partner_g == brick_g)
+    assert joint.sum() > 0
+    assert state.point_bonded[pts[joint]].all()
+    assert not state.point_bonded[pts[~joint]].any()  # base material: no cohesion, not bonded
+    # every brick above the first course carries bed-joint points
+    for name in model.block_names:
+        if name.startswith("brick_") and not name.startswith("brick_0_"):
+            b = model.block_id(name)
+            touching = set(state.point_partner[a.point_block == b]) | set(a.point_block[pts[state.point_partner[pts] == b]])
+            assert len(touching - {-1, b}) >= 2
+
+
+def test_running_bond_needs_an_odd_point_count_along():
+    with pytest.raises(ValueError, match="odd count"):
+        brick_wall(ModelBuilder(), courses=2, bricks_per_course=2, points=(2, 2), joint=MORTAR)
+
+
+def test_running_bond_wall_stands_under_gravity():
+    # Cohesionless joints, gravity only, mass-proportional damping for 0.2 s: the half-brick
+    # offset lands on an interface point, so every brick is supported and nothing moves (< 1 mm).
+    bld = ModelBuilder()
+    mon = brick_wall(bld, courses=5, bricks_per_course=3, joint=JointMaterial.from_modulus(1.8e9, 0.076, friction_angle=31))
+    ds = simulate(bld.finalize(damping=Damping(alpha=20.0)), 0.2, monitors=mon)
+    assert np.abs(ds.block_displacement.values).max() < 1e-3
+    assert np.abs(ds.monitor_displacement.values).max() < 1e-3
+
+
+def test_parapet_base_contact_width_single_and_discretised():
+    bld = ModelBuilder()
+    parapet(bld, height=1.0, length=1.2, material=MORTAR)
+    assert _bottom_width(bld.block("parapet")) == pytest.approx(0.23 - 0.007, rel=1e-12)
+    bld2 = ModelBuilder()
+    parapet(bld2, height=0.95, length=1.2, brick=(0.23, 0.076), material=MORTAR)
+    model = bld2.finalize()
+    initial_state(model)
+    assert _bottom_width(bld2.block("brick_0_0")) == pytest.approx(0.223, rel=1e-12)
+    assert _bottom_width(bld2.block("brick_1_0")) == pytest.approx(0.23, rel=1e-12)
+
+
+def test_rounded_edges_reduce_the_base_as_designed():
+    bld = ModelBuilder()
+    facade(bld, edge_radius=0.008, edge_facets=5, material=JointMaterial(kn=2.25e9))
+    poly = bld.block("facade")
+    assert _bottom_width(poly) == pytest.approx(0.11 - 2 * 0.008, rel=1e-12)
+    # 2 ends + bottom + top + 2 sides + 5 facets per rounded edge
+    assert len(poly.faces) == 6 + 2 * 5
+    with pytest.raises(ValueError, match="edge_radius"):
+        facade(ModelBuilder(), edge_radius=0.06)
+
+
+def _facade_run(**kw):
+    bld = ModelBuilder()
+    mon = facade(bld, material=JointMaterial.from_modulus(1.8e9, 0.8, friction_angle=31), edge_radius=0.008, **kw)
+    return bld, mon
+
+
+def test_facade_inward_rotation_stops_at_the_gap():
+    # An inward rocking rate that would carry a free block to ~4 gap/H (energy: I_O w^2 / 2 =
+    # m g (B/2) theta) is stopped by the return walls at theta = gap / H and rebounds outward.
+    gap, h = 0.004, 0.8
+    out = {}
+    for g in (gap, 0.05):
+        bld, mon = _facade_run(gap=g, rocking_velocity=0.4)
+        model = bld.finalize(damping=Damping(beta=0.00025))
+        ds = simulate(model, 0.6, monitors=mon, record_interval=1e-3)
+        out[g] = ds.rocking_angle.values[:, model.block_id("facade")]
+    th = out[gap]
+    assert th.max() == pytest.approx(gap / h, rel=0.03)  # contact at the top edge, kn overlap
+    assert out[0.05].max() > 3 * gap / h  # without the walls it would go much further
+    assert th[np.argmax(th):].min() < 0  # rebounded outward past vertical
+
+
+def test_facade_outward_tilt_rocks_back_into_the_walls_and_out_again():
+    gap, h = 0.004, 0.8
+    bld, mon = _facade_run(gap=gap)
+    bld.tilt("facade", 0.5, direction=(-1.0, 0.0, 0.0))
+    model = bld.finalize(damping=Damping(beta=0.00025))
+    ds = simulate(model, 0.8, monitors=mon, record_interval=1e-3)
+    th = ds.rocking_angle.values[:, model.block_id("facade")]
+    assert th[0] < -0.05
+    assert th.max() == pytest.approx(gap / h, rel=0.03)  # one-sided: stopped by the return walls
+    assert th[np.argmax(th):].min() < -0.001  # bounced back out
+
+
+def test_two_block_wall_push_reaches_d0():
+    # Griffith et al. (§4.4), E = 48 MPa. The soft joints penetrate ~0.5 mm, more than the default
+    # contact tolerance (1 % of the 20-mm rods), so the tolerance is raised to 2 mm.
+    d0, tp = 0.03, 0.3
+    bld = ModelBuilder()
+    mon = two_block_wall(bld, material=JointMaterial.from_modulus(48e6, 0.75, friction_angle=35), push_displacement=d0, push_time=tp)
+    model = bld.finalize(damping=Damping(beta=0.0032), contact_tolerance=0.002)
+    ds = simulate(model, tp, monitors=mon, record_interval=1e-3)
+    mid = ds.monitor_displacement.sel(monitor="mid").values[-1, 0]
+    rod = ds.monitor_displacement.sel(monitor="rod_push").values[-1, 0]
+    assert rod == pytest.approx(d0, rel=1e-3)
+    assert mid == pytest.approx(d0, rel=0.03)
+    with pytest.raises(ValueError, match="push_displacement"):
+        two_block_wall(ModelBuilder(), material=MORTAR, push_displacement=0.2)
+
+
+def test_stacked_blocks_build():
+    bld = ModelBuilder()
+    mon = stacked_blocks(bld, width=0.2, length=1.0, heights=[1.0, 1.0], material=MORTAR)
+    model = bld.finalize()
+    initial_state(model)
+    assert mon["top"] == ("block2", (0.1, 0.0, 2.0))
+    assert model.arrays.block_free.sum() == 2
+
+
+_JOINT = {"youngs_modulus": 1.8e9, "friction_angle_deg": 31.0}
+CASES = {
+    "stack": {"width": 0.2, "heights": [1.0, 1.0], **_JOINT},
+    "wall": {"brick": [0.11, 0.23, 0.076], "courses": 3, "bricks_per_course": 2, "joint": {**_JOINT, "cohesion": 1e5}},
+    "parapet": {"height": 1.0, "length": 1.2, "brick": [0.23, 0.076], **_JOINT},
+    "facade": {"edge_radius": 0.008, "slope_deg": 0.2, **_JOINT, "return": {"kn": 1e9, "friction_angle_deg": 0.0}},
+    "two-block-wall": {"push_displacement": 0.02, **_JOINT},
+}
+
+
+@pytest.mark.parametrize("kind", sorted(CASES))
+def test_toml_forms_parse_and_reject_unknown_keys(kind):
+    data = {"run": {"duration": 0.1}, "specimen": {"type": kind, **CASES[kind]}}
+    case = parse_case(data)
+    assert case.model.arrays.block_free.sum() >= 1
+    assert "top" in case.monitors
+    initial_state(case.model)
+    bad = {"run": {"duration": 0.1}, "specimen": {"type": kind, **CASES[kind], "widht": 1.0}}
+    with pytest.raises(ValueError, match="widht"):
+        parse_case(bad)
+
+
+def test_toml_wall_rejects_unknown_joint_key():
+    data = {"run": {"duration": 0.1}, "specimen": {"type": "wall", **CASES["wall"]}}
+    data["specimen"]["joint"] = {**_JOINT, "cohesoin": 1.0}
+    with pytest.raises(ValueError, match="cohesoin"):
+        parse_case(data)
+
+
+@pytest.mark.parametrize(
+    "call,field",
+    [
+        (lambda b: brick_wall(b, courses=0, bricks_per_course=2, joint=MORTAR), "courses"),
+        (lambda b: brick_wall(b, brick=(0.1, -0.2, 0.07), courses=1, bricks_per_course=2, joint=MORTAR), "brick"),
+        (lambda b: facade(b, gap=-0.001), "gap"),
+        (lambda b: parapet(b, height=1.0, length=1.0, base_reduction=0.3), "base_reduction"),
+        (lambda b: stacked_blocks(b, width=0.2, length=1.0, heights=[]), "heights"),
+        (lambda b: facade(b, slope_deg=-1.0), "slope_deg"),
+    ],
+)
+def test_bad_input_names_the_field(call, field):
+    with pytest.raises(ValueError, match=field):
+        call(ModelBuilder())
