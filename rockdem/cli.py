@@ -13,6 +13,7 @@ _COMMAND_MODULES = (
     "rockdem.plots",
     "rockdem.animate",
     "rockdem.vtk_export",
+    "rockdem.studies",
 )
 
 

@@ -30,7 +30,7 @@ from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "save", "load", "export_csv"]
+__all__ = ["build_dataset", "block_eta", "save", "load", "export_csv"]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -97,6 +97,7 @@ def build_dataset(
         {"units": "1", "note": "error / max over time of (kinetic + elastic + |potential| + dissipated + |work|)"},
     )
     m = model.arrays
+    ds["block_eta"] = ("block", block_eta(model), {"units": "rad", "note": "instability angle about the base edge"})
     ds["block_mass"] = ("block", m.block_mass, {"units": "kg"})
     ds["block_free"] = ("block", m.block_free)
     ds["block_group"] = ("block", np.array([model.group_names[g] for g in m.block_group], dtype=object))
@@ -124,6 +125,29 @@ def build_dataset(
         }
     )
     return ds
+
+
+def block_eta(model: Model) -> np.ndarray:
+    """Instability (slenderness) angle of each free block about its base edges [rad], NaN for
+    driven blocks: atan(horizontal distance from the centroid to the nearer base edge along the
+    rocking direction / height of the centroid above the base), at the reference pose.
+    The rocking direction is rocking_axis x up (up opposes gravity)."""
+    m = model.arrays
+    g = m.gravity
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    d = np.cross(model.rocking_axis, up)
+    out = np.full(model.block_count, np.nan)
+    if np.linalg.norm(d) == 0:
+        return out
+    d /= np.linalg.norm(d)
+    rref = quats_to_matrices(model.quaternion_ref)
+    for b in np.flatnonzero(m.block_free):
+        v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref[b].T
+        height = -float(np.min(v @ up))
+        half = min(float(np.max(v @ d)), -float(np.min(v @ d)))
+        if height > 0 and half > 0:
+            out[b] = float(np.arctan2(half, height))
+    return out
 
 
 def _version() -> str:

@@ -87,9 +87,10 @@ def simulate(
     bar = None
     interrupted = False
     try:
-        while state.clock[0] < duration - 1e-12 * duration and frame <= frames:
+        t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
+        while state.clock[0] < t_end and frame < frames:
             t_before = float(state.clock[0])
-            stop = snaps.clip(min(duration, t_before + chunk))
+            stop = snaps.clip(min(t_end, t_before + chunk))
             t0 = _time.perf_counter()
             frame = advance(m, state, scratch, stop, record_interval, rec, frame)
             elapsed = _time.perf_counter() - t0

@@ -406,7 +406,7 @@ def advance(
         h = 0.5 * (s.clock[2] + dt)
         compute_forces(m, s, sc, t, s.clock[2])
         now = -1
-        if frame < rec.time.shape[0] and t >= frame * record_interval - 1e-9 * dt:
+        if frame < rec.time.shape[0] and t >= frame * record_interval - 0.5 * dt:
             now = frame
         integrate_velocities(m, s, sc, t, h, rec, now)
         dashpot_work(m, s, sc, h)

@@ -1,0 +1,651 @@
+"""Studies at scale: sweeps of small picklable run specs, a crash-safe store, executors (DESIGN §5).
+
+A study is a base case (a case dict, e.g. ``example_case("free-rocking")``) plus variations
+(grid, list or seeded random samples of ``"table.key"`` overrides). Each variation becomes a
+:class:`RunSpec`, a frozen, picklable value with a stable :attr:`RunSpec.id` (sha1 of its canonical
+JSON). :func:`run_spec` is a pure function spec -> summary row (a flat dict), optionally with a
+decimated history. :func:`execute` runs the specs that are not yet in a :class:`Store` serially, in a
+local process pool (default, all cores) or on a Dask cluster, appending each finished row to the
+store at once (flushed and fsynced): an interrupted study loses no finished run and a rerun skips
+finished specs. :func:`study_table` builds the pandas table (CSV, and Parquet when available).
+
+Command line: ``rockdem sweep STUDY.toml``, ``rockdem calibrate``, ``rockdem fragility`` (the
+latter two from :mod:`rockdem.calibration` and :mod:`rockdem.fragility`, registered here).
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import hashlib
+import itertools
+import json
+import math
+import os
+import time
+import tomllib
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .case import LOADINGS, Table, apply_overrides, example_case, example_names, load_case, loading, parse_case
+
+__all__ = [
+    "RunSpec",
+    "run_spec",
+    "Store",
+    "execute",
+    "study_table",
+    "save_table",
+    "expand_grid",
+    "expand_list",
+    "expand_random",
+    "make_specs",
+    "Study",
+    "load_study",
+    "run_study",
+    "resolve_base",
+    "TIMING_COLUMNS",
+    "register_cli",
+]
+
+TIMING_COLUMNS = ("runtime_s", "wall_s")
+"""Row entries that measure time and therefore differ between otherwise identical runs."""
+
+EXECUTORS = ("process", "serial", "dask")
+
+
+# --------------------------------------------------------------------------------------------------
+# specs
+# --------------------------------------------------------------------------------------------------
+def _canonical(obj: Any) -> str:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+
+
+def _plain(value: Any) -> Any:
+    """NumPy scalars -> Python scalars (so that specs hash and serialise the same way)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a study: a pure, picklable description.
+
+    Attributes:
+        base: the base case dict (as read from TOML).
+        overrides: ``(("table.key", value), ...)``, sorted by key (use :meth:`make`).
+        duration: simulated time [s]; None keeps ``[run] duration`` of the case.
+        record: ground-motion record (a name in the shared records folder, or a file path); when
+            given, the case's ``[loading]`` table is replaced by a ``type = "record"`` loading.
+        pga_g: target peak ground acceleration of the record [g] (None: record unscaled).
+        history: keep a decimated history (time, rotation, monitor displacement) in the row.
+        history_interval: decimation of the history [s] (None: the case's record interval).
+    """
+
+    base: Mapping[str, Any]
+    overrides: tuple[tuple[str, Any], ...] = ()
+    duration: float | None = None
+    record: str | None = None
+    pga_g: float | None = None
+    history: bool = False
+    history_interval: float | None = None
+
+    @classmethod
+    def make(cls, base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None, **kwargs: Any) -> "RunSpec":
+        """Build a spec from an overrides mapping ``{"damping.beta": 0.002, ...}``."""
+        items = tuple(sorted((str(k), _plain(v)) for k, v in (overrides or {}).items()))
+        for key in ("duration", "pga_g", "history_interval"):
+            if kwargs.get(key) is not None:
+                kwargs[key] = float(kwargs[key])
+        return cls(base=base, overrides=items, **kwargs)
+
+    def to_json(self) -> dict[str, Any]:
+        """Canonical JSON-able form (what the id hashes)."""
+        return {
+            "base": self.base,
+            "overrides": [[k, v] for k, v in self.overrides],
+            "duration": self.duration,
+            "record": self.record,
+            "pga_g": self.pga_g,
+            "history": self.history,
+            "history_interval": self.history_interval,
+        }
+
+    @property
+    def id(self) -> str:
+        """Stable identifier: first 16 hex digits of sha1(canonical JSON)."""
+        return hashlib.sha1(_canonical(self.to_json()).encode()).hexdigest()[:16]
+
+    @property
+    def inputs(self) -> dict[str, Any]:
+        """The varied inputs, as table columns."""
+        out: dict[str, Any] = dict(self.overrides)
+        if self.duration is not None:
+            out["duration"] = self.duration
+        if self.record is not None:
+            out["record"] = self.record
+            out["pga_g"] = self.pga_g
+        return out
+
+    def case_dict(self) -> dict[str, Any]:
+        """The full case dict of this run."""
+        data = copy.deepcopy(dict(self.base))
+        if self.record is not None:
+            data["loading"] = {"type": "record", "record": self.record}
+            if self.pga_g is not None:
+                data["loading"]["pga_g"] = self.pga_g
+        data = apply_overrides(data, [f"{k}={_toml_value(v)}" for k, v in self.overrides])
+        if self.duration is not None:
+            data.setdefault("run", {})["duration"] = self.duration
+        return data
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(float(v)) if isinstance(v, float) else str(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise ValueError(f"override value {v!r} is not a TOML scalar or list")
+
+
+def _block_eta(data: Mapping[str, Any]) -> float | None:
+    sp = data.get("specimen", {})
+    if sp.get("type") == "block" and "width" in sp and "height" in sp:
+        return float(math.atan2(float(sp["width"]), float(sp["height"])))
+    return None
+
+
+def run_spec(spec: RunSpec) -> dict[str, Any]:
+    """Run one spec and return its summary row (pure: same spec -> same row, timings aside).
+
+    Row keys: ``id``, the inputs (override keys, duration, record, pga_g), ``status`` ("ok"),
+    ``max_rotation_rad``, ``max_rotation_over_eta``, ``overturned``, ``residual_rad``,
+    ``residual_disp_m`` / ``max_disp_m`` (first monitor, horizontal), ``e_a_mean``,
+    ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``,
+    ``runtime_s`` (engine), ``wall_s`` (whole run), and ``history`` when asked for.
+    """
+    from .analysis import summarize_result
+    from .run_cli import run_case
+
+    t0 = time.perf_counter()
+    data = spec.case_dict()
+    case = parse_case(data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = run_case(case, progress=False)
+    eta = _block_eta(data)
+    free = np.flatnonzero(ds.block_free.values)
+    b = int(free[0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s = summarize_result(ds, block=b, eta=eta)
+    t = np.asarray(ds.time.values, dtype=float)
+    theta = np.asarray(ds.rocking_angle.values[:, b], dtype=float)
+    a = ds.attrs
+    npts = max(int(a.get("point_count", 1)), 1)
+    row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "ok"}
+    row["max_rotation_rad"] = float(s["max_rotation_rad"])
+    row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
+    row["overturned"] = bool(s.get("overturned", False))
+    row["residual_rad"] = float(s["residual_rad"])
+    if ds.sizes.get("monitor", 0):
+        u = np.asarray(ds.monitor_displacement.values[:, 0, :], dtype=float)
+        uh = np.linalg.norm(u[:, :2], axis=1)
+        row["max_disp_m"] = float(uh.max())
+        row["residual_disp_m"] = float(u[-1, 0])
+    row["e_a_mean"] = float(s["e_a_mean"]) if "e_a_mean" in s else None
+    row["bounce_max_m_s"] = float(s["bounce_max_m_s"]) if "bounce_max_m_s" in s else None
+    row["failed_shear_fraction"] = int(ds.contacts_failed_shear.values[-1]) / npts
+    row["failed_tension_fraction"] = int(ds.contacts_failed_tension.values[-1]) / npts
+    row["steps"] = int(a["steps"])
+    row["dt"] = float(a["dt"])
+    row["runtime_s"] = float(a["runtime_s"])
+    if spec.history:
+        step = 1
+        if spec.history_interval and len(t) > 1:
+            step = max(1, int(round(spec.history_interval / (t[1] - t[0]))))
+        hist: dict[str, Any] = {"time": t[::step].tolist(), "rotation": theta[::step].tolist()}
+        if ds.sizes.get("monitor", 0):
+            hist["displacement"] = ds.monitor_displacement.values[::step, 0, 0].astype(float).tolist()
+        row["history"] = hist
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _safe_run(spec: RunSpec) -> dict[str, Any]:
+    """:func:`run_spec`, with an error row instead of an exception (a study goes on)."""
+    try:
+        return run_spec(spec)
+    except Exception as exc:  # noqa: BLE001 - a failed run is recorded, not fatal
+        return {"id": spec.id, **spec.inputs, "status": "error", "error": f"{type(exc).__name__}: {exc}"}
+
+
+# --------------------------------------------------------------------------------------------------
+# ground-motion loading used by IDA specs
+# --------------------------------------------------------------------------------------------------
+def _record_loading(t: Table, b: Any, monitors: Any, ctx: dict[str, Any]) -> None:
+    """A ground-motion record applied as the inertial body force -m a_g(t) on every free block.
+
+    Keys: record (name in the shared ground-motion folder, or a file path), units (for files that
+    do not say), pga_g (scale to this PGA [g]), scale (factor, if no pga_g), direction (default +x).
+    """
+    from .records import read_record, shared_record_path
+
+    name = t.string("record")
+    units = t.raw("units", None)
+    pga_g = t.optional_number("pga_g", positive=True)
+    scale = t.number("scale", 1.0, positive=True)
+    d = t.vector("direction", (1.0, 0.0, 0.0))
+    path = Path(name)
+    if not path.is_file():
+        path = shared_record_path(name)
+    gm = read_record(path, units=units) if units is not None else read_record(path)
+    gm = gm.scaled_to_pga(pga_g * 9.80665) if pga_g is not None else gm.scaled(scale)
+    d = np.asarray(d, dtype=float) / np.linalg.norm(d)
+    time_ = gm.time
+    acc = -np.outer(gm.acceleration, d)
+    b.set_body_acceleration(time_, acc)
+    ctx["record"] = gm.name
+
+
+if "record" not in LOADINGS:
+    loading("record")(_record_loading)
+
+
+# --------------------------------------------------------------------------------------------------
+# store
+# --------------------------------------------------------------------------------------------------
+class Store:
+    """Append-only JSON-lines store of finished rows, one line per run, fsynced at once.
+
+    Reading tolerates a truncated or corrupt last line (an interrupted write). When an id appears
+    several times (an error retried), the last "ok" row wins.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        p = Path(path)
+        if p.suffix != ".jsonl":
+            p = p / "runs.jsonl"
+        p.parent.mkdir(parents=True, exist_ok=True)
+        self.path = p
+
+    def rows(self) -> list[dict[str, Any]]:
+        """All stored rows, one per id (in first-finished order)."""
+        if not self.path.exists():
+            return []
+        by_id: dict[str, dict[str, Any]] = {}
+        with self.path.open("rb") as fh:
+            for raw in fh:
+                try:
+                    row = json.loads(raw)
+                except ValueError:
+                    continue  # a truncated line from an interrupted write
+                if not isinstance(row, dict) or "id" not in row:
+                    continue
+                old = by_id.get(row["id"])
+                if old is None or old.get("status") != "ok":
+                    by_id[row["id"]] = row
+        return list(by_id.values())
+
+    def done_ids(self) -> set[str]:
+        """Ids of the runs finished successfully."""
+        return {r["id"] for r in self.rows() if r.get("status") == "ok"}
+
+    def append(self, row: Mapping[str, Any]) -> None:
+        """Append one row and make it durable (flush + fsync)."""
+        line = json.dumps(row, separators=(",", ":"), default=_json_default) + "\n"
+        # a previous interrupted write may have left a partial line: start on a fresh line
+        if self.path.exists() and self.path.stat().st_size > 0:
+            with self.path.open("rb") as fh:
+                fh.seek(-1, os.SEEK_END)
+                if fh.read(1) != b"\n":
+                    line = "\n" + line
+        with self.path.open("a", encoding="utf-8") as fh:
+            fh.write(line)
+            fh.flush()
+            os.fsync(fh.fileno())
+
+
+def _json_default(v: Any) -> Any:
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    return str(v)
+
+
+# --------------------------------------------------------------------------------------------------
+# executors
+# --------------------------------------------------------------------------------------------------
+def _iter_process(specs: Sequence[RunSpec], workers: int | None, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    n = workers or os.cpu_count() or 1
+    pool = ProcessPoolExecutor(max_workers=min(n, len(specs)), mp_context=mp.get_context("spawn"))
+    try:
+        futures = [pool.submit(fn, s) for s in specs]
+        for fut in as_completed(futures):
+            yield fut.result()
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _iter_dask(specs: Sequence[RunSpec], scheduler: Any, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
+    try:
+        from distributed import Client, as_completed
+    except ImportError as exc:  # pragma: no cover - optional extra
+        raise ValueError("the dask executor needs the optional extra: pip install 'rockdem[dask]'") from exc
+    own = not isinstance(scheduler, Client)
+    client = Client(scheduler) if own else scheduler
+    try:
+        keys = [f"rockdem-run-{s.id}" for s in specs]
+        futures = client.map(fn, list(specs), key=keys, pure=False)
+        try:
+            for fut in as_completed(futures):
+                yield fut.result()
+        finally:
+            client.cancel(futures)
+    finally:
+        if own:
+            client.close()
+
+
+def execute(
+    specs: Iterable[RunSpec],
+    store: Store | str | os.PathLike[str] | None = None,
+    *,
+    executor: str = "process",
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = True,
+) -> list[dict[str, Any]]:
+    """Run the specs not yet finished in ``store``; each finished row is stored at once.
+
+    Args:
+        specs: run specs (duplicates, by id, run once).
+        store: a :class:`Store` or its folder / ``.jsonl`` path; None keeps rows in memory only.
+        executor: "process" (local process pool, default), "serial" or "dask".
+        workers: process count for "process" (default: all cores).
+        scheduler: Dask scheduler address (or a ``distributed.Client``); implies "dask".
+        progress: show a progress bar with ETA (tqdm).
+
+    Returns:
+        The rows of all specs (stored ones included), in the order of ``specs``.
+    """
+    if scheduler is not None:
+        executor = "dask"
+    if executor not in EXECUTORS:
+        raise ValueError(f"executor must be one of {EXECUTORS}, got {executor!r}")
+    if executor == "dask" and scheduler is None:
+        raise ValueError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
+    unique: dict[str, RunSpec] = {}
+    for s in specs:
+        unique.setdefault(s.id, s)
+    st = Store(store) if store is not None and not isinstance(store, Store) else store
+    stored = {r["id"]: r for r in st.rows()} if st is not None else {}
+    done = {i for i, r in stored.items() if r.get("status") == "ok"}
+    todo = [s for i, s in unique.items() if i not in done]
+    results: dict[str, dict[str, Any]] = {i: stored[i] for i in unique if i in done}
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(unique), initial=len(unique) - len(todo), disable=not progress, unit="run", desc="study")
+    try:
+        if not todo:
+            return [results[i] for i in unique]
+        if executor == "serial":
+            it: Iterator[dict] = (_safe_run(s) for s in todo)
+        elif executor == "process":
+            it = _iter_process(todo, workers, _safe_run)
+        else:
+            it = _iter_dask(todo, scheduler, _safe_run)
+        for row in it:
+            if st is not None:
+                st.append(row)
+            results[row["id"]] = row
+            bar.update(1)
+    finally:
+        bar.close()
+    return [results[i] for i in unique if i in results]
+
+
+# --------------------------------------------------------------------------------------------------
+# table
+# --------------------------------------------------------------------------------------------------
+def study_table(rows: Store | str | os.PathLike[str] | Iterable[Mapping[str, Any]], *, specs: Sequence[RunSpec] | None = None) -> pd.DataFrame:
+    """The study table: one row per run, scalar columns only (histories dropped), sorted by id.
+
+    Args:
+        rows: a store (or its path) or rows.
+        specs: keep only (and order by) these specs.
+    """
+    if isinstance(rows, (str, os.PathLike)):
+        rows = Store(rows)
+    data = rows.rows() if isinstance(rows, Store) else list(rows)
+    data = [{k: v for k, v in r.items() if k != "history"} for r in data]
+    df = pd.DataFrame(data)
+    if df.empty:
+        return df
+    if specs is not None:
+        order = {s.id: k for k, s in enumerate(specs)}
+        df = df[df["id"].isin(order)].copy()
+        df["_order"] = df["id"].map(order)
+        return df.sort_values("_order").drop(columns="_order").reset_index(drop=True)
+    return df.sort_values("id").reset_index(drop=True)
+
+
+def save_table(df: pd.DataFrame, folder: str | os.PathLike[str], name: str = "table") -> list[Path]:
+    """Write ``name.csv`` (and ``name.parquet`` when pyarrow or fastparquet is installed)."""
+    out = Path(folder)
+    out.mkdir(parents=True, exist_ok=True)
+    paths = [out / f"{name}.csv"]
+    df.to_csv(paths[0], index=False)
+    try:
+        df.to_parquet(out / f"{name}.parquet", index=False)
+        paths.append(out / f"{name}.parquet")
+    except (ImportError, ValueError):
+        pass
+    return paths
+
+
+def histories(rows: Store | Iterable[Mapping[str, Any]]) -> dict[str, dict[str, np.ndarray]]:
+    """Decimated histories by run id: {"time", "rotation", "displacement"} arrays."""
+    data = rows.rows() if isinstance(rows, Store) else list(rows)
+    return {r["id"]: {k: np.asarray(v, dtype=float) for k, v in r["history"].items()} for r in data if r.get("history")}
+
+
+# --------------------------------------------------------------------------------------------------
+# variations
+# --------------------------------------------------------------------------------------------------
+def expand_grid(params: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
+    """Full factorial: ``{"a": [1, 2], "b": [3]}`` -> ``[{"a": 1, "b": 3}, {"a": 2, "b": 3}]``."""
+    keys = list(params)
+    for k in keys:
+        if not isinstance(params[k], (list, tuple)) or len(params[k]) == 0:
+            raise ValueError(f"grid parameter {k!r}: give a non-empty list of values")
+    return [dict(zip(keys, combo)) for combo in itertools.product(*(params[k] for k in keys))]
+
+
+def expand_list(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """Explicit variations, one mapping per run."""
+    out = []
+    for r in rows:
+        if not isinstance(r, Mapping):
+            raise ValueError(f"list variation {r!r}: give a table of table.key = value")
+        out.append(dict(r))
+    return out
+
+
+def expand_random(ranges: Mapping[str, Any], n: int, seed: int) -> list[dict[str, Any]]:
+    """``n`` seeded uniform samples; a range is ``[low, high]`` or ``{low, high, log = true}``
+    (log-uniform) or a list of more than two choices (``{choices = [...]}``)."""
+    if n < 1:
+        raise ValueError(f"random: n must be >= 1, got {n}")
+    rng = np.random.default_rng(seed)
+    out: list[dict[str, Any]] = [{} for _ in range(n)]
+    for key in sorted(ranges):
+        r = ranges[key]
+        if isinstance(r, Mapping) and "choices" in r:
+            idx = rng.integers(0, len(r["choices"]), size=n)
+            vals = [r["choices"][i] for i in idx]
+        else:
+            lo, hi, log = (r["low"], r["high"], bool(r.get("log", False))) if isinstance(r, Mapping) else (*r, False)
+            lo, hi = float(lo), float(hi)
+            if not hi > lo or (log and lo <= 0):
+                raise ValueError(f"random parameter {key!r}: need low < high (and low > 0 for log)")
+            u = rng.random(n)
+            vals = list(np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo))) if log else lo + u * (hi - lo))
+        for row, v in zip(out, vals):
+            row[key] = _plain(v)
+    return out
+
+
+def make_specs(
+    base: Mapping[str, Any],
+    variations: Iterable[Mapping[str, Any]],
+    *,
+    fixed: Mapping[str, Any] | None = None,
+    duration: float | None = None,
+    history: bool = False,
+    history_interval: float | None = None,
+) -> list[RunSpec]:
+    """One spec per variation (``fixed`` overrides are applied to every run)."""
+    return [
+        RunSpec.make(base, {**(fixed or {}), **v}, duration=duration, history=history, history_interval=history_interval)
+        for v in variations
+    ]
+
+
+def resolve_base(base: str | Mapping[str, Any], relative_to: str | os.PathLike[str] | None = None) -> dict[str, Any]:
+    """A base case dict from a built-in example name, a TOML path or a dict."""
+    if isinstance(base, Mapping):
+        return dict(base)
+    if base in example_names():
+        return example_case(base)
+    p = Path(base)
+    if not p.is_absolute() and relative_to is not None:
+        p = Path(relative_to) / p
+    return load_case(p)
+
+
+@dataclass
+class Study:
+    """A study read from TOML: its specs and execution options."""
+
+    name: str
+    specs: list[RunSpec]
+    executor: str = "process"
+    workers: int | None = None
+    scheduler: str | None = None
+    options: dict[str, Any] = field(default_factory=dict)
+
+
+def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] | None = None, name: str = "study") -> Study:
+    """Build a :class:`Study` from a dict of the study file format (see docs/studies.md)."""
+    if "study" not in data:
+        raise ValueError("a study file needs a [study] table")
+    s = dict(data["study"])
+    allowed = {"base", "duration", "executor", "workers", "scheduler", "set", "grid", "list", "random", "history", "history_interval", "name"}
+    unknown = sorted(set(s) - allowed)
+    if unknown:
+        raise ValueError(f"[study] unknown key(s) {unknown}; accepted keys are {sorted(allowed)}")
+    if "base" not in s:
+        raise ValueError('[study] needs base = "free-rocking" (a built-in example) or a case file path')
+    base = resolve_base(s["base"], relative_to)
+    fixed = dict(s.get("set", {}))
+    parts: list[list[dict[str, Any]]] = []
+    if "grid" in s:
+        parts.append(expand_grid(s["grid"]))
+    if "list" in s:
+        lst = s["list"]
+        parts.append(expand_list(lst["rows"] if isinstance(lst, Mapping) else lst))
+    if "random" in s:
+        r = dict(s["random"])
+        n, seed = int(r.pop("n", 10)), int(r.pop("seed", 0))
+        parts.append(expand_random(r, n, seed))
+    variations = [{}]
+    for part in parts:
+        variations = [{**a, **b} for a in variations for b in part]
+    executor = str(s.get("executor", "process"))
+    if executor not in EXECUTORS:
+        raise ValueError(f"[study] executor must be one of {EXECUTORS}, got {executor!r}")
+    specs = make_specs(
+        base, variations, fixed=fixed, duration=s.get("duration"), history=bool(s.get("history", False)),
+        history_interval=s.get("history_interval"),
+    )
+    return Study(str(s.get("name", name)), specs, executor, s.get("workers"), s.get("scheduler"), s)
+
+
+def load_study(path: str | os.PathLike[str]) -> Study:
+    """Read a study TOML file."""
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"study file {p} does not exist")
+    try:
+        data = tomllib.loads(p.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{p}: not valid TOML: {exc}") from None
+    return parse_study(data, relative_to=p.parent, name=p.stem)
+
+
+def run_study(study: Study, out: str | os.PathLike[str], *, executor: str | None = None, workers: int | None = None,
+              scheduler: str | None = None, progress: bool = True) -> pd.DataFrame:
+    """Run (or resume) a study into folder ``out``: ``runs.jsonl`` and ``table.csv`` (+ parquet)."""
+    store = Store(out)
+    execute(study.specs, store, executor=executor or study.executor, workers=workers or study.workers,
+            scheduler=scheduler or study.scheduler, progress=progress)
+    df = study_table(store, specs=study.specs)
+    save_table(df, Path(out))
+    return df
+
+
+# --------------------------------------------------------------------------------------------------
+# CLI
+# --------------------------------------------------------------------------------------------------
+def _add_exec_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--executor", choices=EXECUTORS, default=None, help="default: the study's, else process")
+    p.add_argument("--workers", type=int, default=None, help="processes of the local pool (default: all cores)")
+    p.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    study = load_study(args.study)
+    out = Path(args.out) if args.out else Path(args.study).with_suffix("")
+    t0 = time.perf_counter()
+    df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                   progress=not args.no_progress)
+    n_err = int((df["status"] != "ok").sum()) if "status" in df else 0
+    print(f"{len(df)} runs ({n_err} failed) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
+    return 0 if n_err == 0 else 1
+
+
+def register_cli(subparsers: argparse._SubParsersAction) -> None:
+    """Add ``sweep``, ``calibrate`` and ``fragility``."""
+    p = subparsers.add_parser("sweep", help="run (or resume) a parameter study from a study TOML file",
+                              description="Run a study file; finished runs are kept in OUT/runs.jsonl and skipped on rerun.")
+    p.add_argument("study", help="study TOML file ([study] base, duration, grid/list/random)")
+    p.add_argument("--out", "-o", default=None, help="output folder (default: the study file name)")
+    _add_exec_args(p)
+    p.set_defaults(func=_sweep)
+    for mod in ("calibration", "fragility"):
+        try:
+            module = __import__(f"rockdem.{mod}", fromlist=["register_cli"])
+        except ModuleNotFoundError as exc:
+            if exc.name != f"rockdem.{mod}":
+                raise
+            continue
+        module.register_cli(subparsers, _add_exec_args)
