@@ -44,6 +44,7 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
         world_vertex=np.zeros((nv, 3)),
         aabb=np.zeros((nb, 6)),
         seen=np.zeros(n_pts, dtype=np.int64),
+        prev_partner=np.full(n_pts, -1, dtype=np.int64),
         passes=np.zeros(1, dtype=np.int64),
         sums=np.zeros(8),
         ground_velocity=np.zeros(3),

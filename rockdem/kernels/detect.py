@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .layout import FAILED_TENSION, ModelArrays, Scratch, State
+from .layout import FAILED_SHEAR, FAILED_TENSION, ModelArrays, Scratch, State
 from .rotation import quat_to_matrix
 
 
@@ -162,15 +162,18 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarr
         owner, oface, target, tface = oth, iface, ref, rface
     passid = sc.passes[0]
     for p in range(m.face_point_start[oface], m.face_point_start[oface + 1]):
-        if sc.seen[p] == passid:
-            continue
         gap = point_in_target(m, s, sc, p, target, tface, tmp)
         if gap > m.contact_tol or tmp[3] > m.contact_tol + max(-gap, 0.0):
             continue
+        if sc.seen[p] == passid:
+            # Claimed already by another pair (a point on the shared edge of two faces): the
+            # previous partner keeps it, so that bonds do not flip between neighbours.
+            if target == sc.prev_partner[p]:
+                s.point_partner[p] = target
+                s.point_target_face[p] = tface
+            continue
         sc.seen[p] = passid
-        if s.point_partner[p] != target:
-            _release(s, p)
-            s.point_partner[p] = target
+        s.point_partner[p] = target
         s.point_target_face[p] = tface
         s.track[s.track_count[0]] = p
         s.track_count[0] += 1
@@ -188,6 +191,7 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
     _world_vertices(m, s, sc)
     sc.passes[0] += 1
     s.track_count[0] = 0
+    sc.prev_partner[:] = s.point_partner
     sc.sums[5] = np.inf
     sc.sums[6] = -1
     sc.sums[7] = -1
@@ -214,6 +218,15 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
     for p in range(m.point_block.shape[0]):
         if s.point_partner[p] >= 0 and sc.seen[p] != passid:
             _release(s, p)
+        elif sc.seen[p] == passid and sc.prev_partner[p] >= 0 and s.point_partner[p] != sc.prev_partner[p]:
+            # Moved on to another block: a bond is sheared off, the shear spring starts anew.
+            if s.point_bonded[p]:
+                s.point_bonded[p] = False
+                s.point_failed[p] = FAILED_SHEAR
+            s.point_shear[p, 0] = 0.0
+            s.point_shear[p, 1] = 0.0
+            s.point_shear[p, 2] = 0.0
+            s.point_normal_force[p] = 0.0
     # Sort the tracked list so that force accumulation order (and results) are deterministic.
     s.track[: s.track_count[0]].sort()
     for b in range(nb):

@@ -126,6 +126,7 @@ class Scratch(NamedTuple):
     world_vertex: np.ndarray  # (nv, 3)
     aabb: np.ndarray  # (nb, 6)
     seen: np.ndarray  # (np,) int64 detection pass that claimed the point
+    prev_partner: np.ndarray  # (np,) int64 partner before the current detection pass
     passes: np.ndarray  # (1,) int64
     sums: np.ndarray  # (8,) [0] elastic energy, [1] active count, [2:5] reaction, [5] min pair separation, [6:8] pair
     ground_velocity: np.ndarray  # (3,) [m/s]
