@@ -18,8 +18,6 @@ import sys
 import tempfile
 import time
 
-import numpy as np
-
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.simulate import simulate
@@ -92,4 +90,3 @@ if __name__ == "__main__":
         bench_wall()
     if "cold" in which:
         bench_cold_start()
-    _ = np

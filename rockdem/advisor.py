@@ -32,6 +32,8 @@ from typing import Any, Iterator
 
 import numpy as np
 
+from .kernels.contact import sp_critical_factor
+
 __all__ = ["Configuration", "AdviceInput", "Advice", "advise", "impact_frequencies", "omega_max_bound", "register_cli"]
 
 BOUNCING_LIMIT_DEG_PER_M = 45.0
@@ -198,12 +200,6 @@ def impact_frequencies(b: float, h: float, density: float, e: float) -> tuple[fl
     )
 
 
-def _sp_factor(beta: float, omega: float) -> float:
-    """Belytschko's reduction sqrt(1 + xi^2) - xi, xi = beta omega / 2 (DESIGN §2)."""
-    xi = 0.5 * beta * omega
-    return math.sqrt(1.0 + xi * xi) - xi
-
-
 def _base_points(b: float, length: float, h: float, n_across: int) -> tuple[np.ndarray, np.ndarray]:
     """Interface points of the base face (n_across x 2, trapezoidal areas) relative to the centroid."""
     if n_across == 1:
@@ -297,12 +293,12 @@ def advise(inputs: AdviceInput | None = None, **kwargs: Any) -> Advice:
     coupling = 2.0 if i.blocks > 1 else 1.0
     w_max = omega_max_bound(b, i.length, h_blk, i.density, kn, ks, i.points, coupling=coupling)
     dt_mp = SAFETY * 2.0 / w_max
-    dt_sp = dt_mp * _sp_factor(beta, w_max)
+    dt_sp = dt_mp * sp_critical_factor(beta, w_max)
     m_min = i.density * b * i.length * h_blk
     k_max = kn * float(np.max(_base_points(b, i.length, h_blk, i.points)[1]))
     w3 = math.sqrt(k_max / m_min)
     dt3 = 0.2 * math.sqrt(m_min / k_max)
-    dt3_sp = dt3 * _sp_factor(beta, w3)
+    dt3_sp = dt3 * sp_critical_factor(beta, w3)
     bouncing = eta_r > BOUNCING_LIMIT_DEG_PER_M
     recs = _recommendations(i, beta, alpha_mp, kn, eta_r, bouncing, dt_mp / dt_sp)
     for msg in warn:

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -29,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from .analysis import wme
+from .plots import save_figure
 from .studies import RunSpec, execute, resolve_base, run_spec
 
 __all__ = ["Reference", "load_reference", "reference_from_row", "CalibrationResult", "calibrate", "wme_of_row", "register_cli"]
@@ -263,8 +263,7 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
     ax.set_title(f"{key} = {result.optimum[key]:.4g}, WME = {result.wme:.3f}")
     ax.legend()
     fig.tight_layout()
-    p = Path(path)
-    fig.savefig(p, dpi=120)
+    p = save_figure(fig, path)
     plt.close(fig)
     return p
 

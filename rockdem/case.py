@@ -30,7 +30,6 @@ __all__ = [
     "LOADINGS",
     "load_case",
     "parse_case",
-    "build_case",
     "example_names",
     "example_case",
     "apply_overrides",
@@ -338,11 +337,6 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         contact_tolerance=run.contact_tolerance,
     )
     return Case(name, model, run, monitors, output, dict(data))
-
-
-def build_case(data: Mapping[str, Any]) -> Case:
-    """Alias of :func:`parse_case` (validate and build)."""
-    return parse_case(data)
 
 
 def _register_builtin_types() -> None:

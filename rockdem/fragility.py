@@ -23,6 +23,7 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.stats import norm
 
+from .plots import save_figure
 from .studies import RunSpec, Store, execute, resolve_base, save_table, study_table
 
 __all__ = [
@@ -160,8 +161,7 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     ax.set_ylabel("PGA [g]")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    p = Path(path)
-    fig.savefig(p, dpi=120)
+    p = save_figure(fig, path)
     plt.close(fig)
     return p
 
@@ -181,8 +181,7 @@ def plot_fragility(frag: Fragility, table: pd.DataFrame | None, path: str | os.P
     ax.set_ylim(-0.02, 1.02)
     ax.legend()
     fig.tight_layout()
-    p = Path(path)
-    fig.savefig(p, dpi=120)
+    p = save_figure(fig, path)
     plt.close(fig)
     return p
 

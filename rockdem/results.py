@@ -51,11 +51,9 @@ def build_dataset(
     """Assemble the recorded frames and the model's static data into a Dataset."""
     t = rec.time
     r = quats_to_matrices(rec.quaternion)  # (T, nb, 3, 3)
-    r0 = quats_to_matrices(model.quaternion0)  # (nb, 3, 3)
     rref = quats_to_matrices(model.quaternion_ref)
-    rel = np.einsum("tbij,bkj->tbik", r, r0)  # rotation since t = 0 (moves monitor points)
-    rotvec = rotation_vector(np.einsum("tbij,bkj->tbik", r, rref))  # since the untilted reference
-    del rel
+    rel_ref = np.einsum("tbij,bkj->tbik", r, rref)  # rotation since the untilted reference
+    rotvec = rotation_vector(rel_ref)
     axis = model.rocking_axis
     ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": np.arange(model.block_count)})
     xyz = ("time", "block", "xyz")
@@ -68,7 +66,6 @@ def build_dataset(
     ds["rocking_angle"] = (("time", "block"), rotvec @ axis, {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)
     mdisp = np.zeros((len(t), len(names), 3))
-    rel_ref = np.einsum("tbij,bkj->tbik", r, rref)
     for k, name in enumerate(names):
         b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
         arm = p_ref - model.position_ref[b]

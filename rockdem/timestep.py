@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .kernels.bound import contact_bound
+from .kernels.contact import sp_critical_factor
 from .model import Model
 from .state import initial_state
 
@@ -44,11 +45,6 @@ class TimestepInfo:
     rule: str
 
 
-def _sp_factor(beta: float, omega: float) -> float:
-    xi = 0.5 * beta * omega
-    return math.sqrt(1.0 + xi * xi) - xi
-
-
 def _all_faces_bound(model: Model) -> tuple[float, float, float]:
     """Critical step if every interface point of every free block touched a fixed partner."""
     m = model.arrays
@@ -70,7 +66,7 @@ def _all_faces_bound(model: Model) -> tuple[float, float, float]:
             return 1.0 / m.block_mass[b] + (np.cross(r, d) ** 2) @ (1.0 / m.block_inertia[b])
 
         w = math.sqrt(coupling * float(np.sum(area * (kn * flex(n) + ks * (flex(t1) + flex(t2))))))
-        f = _sp_factor(beta, w)
+        f = sp_critical_factor(beta, w)
         if 2.0 / w * f < best[0]:
             best = (2.0 / w * f, w, f)
     return best
@@ -114,6 +110,6 @@ def stable_timestep(model: Model, *, rule: str = "bound", safety: float = 0.9, d
         m_min = float(np.min(m.block_mass[free]))
         k_max = float(np.max(m.mat_kn)) * float(np.max(m.point_area[free[m.point_block]]))
         w = math.sqrt(k_max / m_min)
-        f3 = _sp_factor(float(np.max(m.mat_beta)), w)
+        f3 = sp_critical_factor(float(np.max(m.mat_beta)), w)
         return TimestepInfo(0.2 * math.sqrt(m_min / k_max) * f3, critical, om, f3, "3dec")
     return TimestepInfo(safety * critical, critical, om, fac, "bound")

@@ -10,7 +10,6 @@ Every sub-contact reported with a shallow penetration is a point of one block in
 """
 
 import numpy as np
-import pytest
 from scipy.optimize import linprog
 
 from rockdem.geometry import convex_hull

@@ -1,6 +1,5 @@
 """Specimen builders: geometry, mass, bonded joints, short physics checks and the TOML forms."""
 
-import math
 
 import numpy as np
 import pytest

@@ -17,6 +17,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .contact import sp_critical_factor
 from .layout import ModelArrays, Scratch, State
 
 
@@ -96,8 +97,7 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch, out: np.ndarray) -> Non
         if not m.block_free[b] or row[b] <= 0.0:
             continue
         w = math.sqrt(row[b])
-        xi = 0.5 * beta[b] * w
-        f = math.sqrt(1.0 + xi * xi) - xi
+        f = sp_critical_factor(beta[b], w)
         dtb = 2.0 / w * f
         if dtb < out[0]:
             out[0] = dtb

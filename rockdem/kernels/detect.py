@@ -152,14 +152,11 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarr
             lowest, iface = c, g
     ar = m.face_area[rface]
     ai = m.face_area[iface]
-    if ai < ar * (1.0 - 1e-9):
-        owner, oface, target, tface = oth, iface, ref, rface
-    elif ar < ai * (1.0 - 1e-9):
-        owner, oface, target, tface = ref, rface, oth, iface
-    elif ref < oth:
-        owner, oface, target, tface = ref, rface, oth, iface
+    # The smaller face owns the points (tie: the lower block id).
+    if ai < ar * (1.0 - 1e-9) or (ar >= ai * (1.0 - 1e-9) and oth < ref):
+        oface, target, tface = iface, ref, rface
     else:
-        owner, oface, target, tface = oth, iface, ref, rface
+        oface, target, tface = rface, oth, iface
     passid = sc.passes[0]
     for p in range(m.face_point_start[oface], m.face_point_start[oface + 1]):
         gap = point_in_target(m, s, sc, p, target, tface, tmp)
@@ -177,7 +174,6 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarr
         s.point_target_face[p] = tface
         s.track[s.track_count[0]] = p
         s.track_count[0] += 1
-    _ = owner
 
 
 @njit(cache=True)
