@@ -466,8 +466,9 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
             optional ``block_eta (block)`` [rad] and the geometry used by
             :func:`lowest_point_height` (for bouncing).
         block: block index; default the first free block.
-        eta: slenderness angle [rad]; default ``block_eta[block]`` if present, else no e_a and no
-            overturning flag.
+        eta: slenderness angle [rad]; default: for an assembly released by a free-rocking tilt
+            (attrs ``tilted_blocks`` > 1), the assembly's angle ``tilt_angle_rad / tilt_fraction``;
+            else ``block_eta[block]`` if present, else no e_a and no overturning flag.
 
     Raises:
         ValueError: missing variables, no free block, or a bad block index.
@@ -483,6 +484,9 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
         block = int(idx[0])
     if not (0 <= block < len(free)):
         raise ValueError(f"block index {block} out of range 0..{len(free) - 1}")
+    a = getattr(ds, "attrs", {})
+    if eta is None and int(a.get("tilted_blocks", 0)) > 1 and float(a.get("tilt_fraction", 0.0)) > 0:
+        eta = float(a["tilt_angle_rad"]) / float(a["tilt_fraction"])
     if eta is None and "block_eta" in ds.variables:
         eta = float(ds["block_eta"].values[block])
     t = np.asarray(ds["time"].values, dtype=float)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, Mapping
@@ -136,7 +136,9 @@ class RunOptions:
 
 @dataclass(frozen=True)
 class Case:
-    """A built case: the model, run options, monitors and output settings."""
+    """A built case: the model, run options, monitors and output settings, plus what the loading
+    adds to the result: ``attrs`` (scalars, e.g. the pushover ramp, the record and its PGA, the tilt
+    angle) and ``series`` (name -> (times (n,), values (n, 3)), e.g. the ground acceleration)."""
 
     name: str
     model: Model
@@ -144,6 +146,8 @@ class Case:
     monitors: dict[str, Monitor]
     output: dict[str, Any]
     data: dict[str, Any]
+    attrs: dict[str, Any] = field(default_factory=dict)
+    series: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
 
 
 SpecimenBuilder = Callable[[Table, ModelBuilder], dict[str, Monitor]]
@@ -225,14 +229,34 @@ def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
 
 @loading("free-rocking")
 def _free_rocking(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
-    """Tilt a block about its base edge to ``tilt_fraction`` of its instability angle and release.
+    """Tilt the free blocks, as one rigid assembly, about their base edge to ``tilt_fraction`` of
+    the assembly's instability angle and release them (paper §3.1, §3.2, §4.1).
 
-    Keys: block (name, default "block"), tilt_fraction (default 0.9), tilt_direction (default +x).
+    Keys: block (a block name or a list of names; default every free block, e.g. all the bricks
+    of a discretised wall), tilt_fraction (default 0.9), tilt_direction (default +x).
     """
-    name = t.string("block", "block")
+    raw = t.raw("block", None)
+    free = b.block_names(driven=False)
+    if raw is None:
+        names: list[str] = free
+    elif isinstance(raw, str):
+        names = [raw]
+    elif isinstance(raw, list) and raw and all(isinstance(v, str) for v in raw):
+        names = list(raw)
+    else:
+        raise ValueError(f"[{t.where}] block must be a block name or a list of names, got {raw!r}")
+    unknown = [n for n in names if n not in b.block_names()]
+    if unknown:
+        raise ValueError(f"[{t.where}] block: no block named {unknown}; the free blocks are {free[:10]}{' ...' if len(free) > 10 else ''}")
+    if not names:
+        raise ValueError(f"[{t.where}] the specimen has no free block to tilt")
     frac = t.number("tilt_fraction", 0.9, min_=0.0)
     d = t.vector("tilt_direction", (1.0, 0.0, 0.0))
-    ctx["tilt_angle"] = b.tilt(name, frac, direction=d)
+    try:
+        ctx["tilt_angle"] = b.tilt(names, frac, direction=d)
+    except ValueError as exc:
+        raise ValueError(f"[{t.where}] {exc}") from None
+    ctx["attrs"].update(tilt_angle_rad=ctx["tilt_angle"], tilt_fraction=frac, tilted_blocks=len(names))
 
 
 @loading("gravity")
@@ -320,7 +344,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
     spec_t.finish()
     load_t = top.sub("loading")
     lkind = load_t.string("type", "gravity", choices=tuple(sorted(LOADINGS)))
-    ctx: dict[str, Any] = {"run": run}
+    ctx: dict[str, Any] = {"run": run, "attrs": {"loading": lkind}, "series": {}}
     LOADINGS[lkind](load_t, builder, monitors, ctx)
     load_t.finish()
     out_t = top.sub("output")
@@ -336,7 +360,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
         contact_tolerance=run.contact_tolerance,
     )
-    return Case(name, model, run, monitors, output, dict(data))
+    return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
 
 
 def _register_builtin_types() -> None:

@@ -23,7 +23,10 @@ same alpha damps differently. Prefer
 Quasi-static pushover (paper §3.3, Fig. 9A): a lateral body acceleration lambda(t) g d on every free
 block, lambda ramped linearly at ``rate`` [1/s] up to ``max_load_factor`` and held, with Cundall's
 local damping (0.8) so that the response stays quasi-static. Load control traces the capacity
-curve up to its peak only: past the peak the block topples.
+curve up to its peak only: past the peak the block topples. Displacement control
+(:func:`apply_rod_pushover`) drives a frictionless rod against the specimen at a slow constant
+velocity and measures the rod's force: it follows the softening branch past the peak as well
+(load factor = rod force / weight of the free blocks).
 
 Units: SI (m, s, m/s^2); records are converted once by :mod:`rockdem.records`.
 """
@@ -52,6 +55,8 @@ __all__ = [
     "prepare_record",
     "apply_earthquake",
     "apply_pushover",
+    "RodPushover",
+    "apply_rod_pushover",
     "pushover",
     "capacity_curve",
 ]
@@ -225,9 +230,7 @@ def _velocity_table(
 
 
 def _has_ground_blocks(builder: ModelBuilder) -> bool:
-    # ModelBuilder has no public query for this yet (see docs/loading.md, engine requests).
-    blocks = getattr(builder, "_blocks", None)
-    return True if blocks is None else any(getattr(b, "driven", None) == GROUND for b in blocks)
+    return bool(builder.block_names(driven=GROUND))
 
 
 # -- pushover --------------------------------------------------------------------------------
@@ -293,6 +296,127 @@ def apply_pushover(
     return ramp
 
 
+@dataclass(frozen=True)
+class RodPushover:
+    """A displacement-controlled pushover: a driven rod moving at ``velocity`` along ``direction``.
+
+    Attributes:
+        rod: name of the driven rod block.
+        velocity: rod speed [m/s]. displacement: total imposed displacement [m].
+        height: height of the rod's line of contact [m].
+        direction: (3,) horizontal unit vector. weight: weight of the free blocks [N].
+    """
+
+    rod: str
+    velocity: float
+    displacement: float
+    height: float
+    direction: NDArray[np.float64]
+    weight: float
+
+    @property
+    def push_time(self) -> float:
+        """Time to impose the full displacement [s]."""
+        return self.displacement / self.velocity
+
+    def attrs(self) -> dict[str, Any]:
+        """The rod pushover as result attributes (read back by :func:`capacity_curve`)."""
+        return {
+            "pushover_rod": self.rod,
+            "pushover_rod_velocity": self.velocity,
+            "pushover_displacement": self.displacement,
+            "pushover_rod_height": self.height,
+            "pushover_direction": self.direction.tolist(),
+            "pushover_weight": self.weight,
+        }
+
+
+def apply_rod_pushover(
+    builder: ModelBuilder,
+    *,
+    displacement: float,
+    velocity: float,
+    height: float | None = None,
+    direction: ArrayLike = (1.0, 0.0, 0.0),
+    rod_size: float = 0.02,
+    material: Any = None,
+    name: str = "rod_pushover",
+) -> RodPushover:
+    """Add a driven rod that pushes the free blocks of ``builder`` along ``direction``.
+
+    The rod (square section ``rod_size``, as long as the specimen across the push) touches the
+    specimen's face on the ``-direction`` side with its line of contact at ``height``, moves at
+    ``velocity`` until it has imposed ``displacement``, then stops. Its contact is frictionless
+    (a roller) so that the face can slide up as the specimen rocks. With ``height`` at the free
+    blocks' centre of mass (the default) the rod force over the weight equals the load factor of
+    a uniform lateral body load: the rigid-block capacity is B/H for a block (paper Fig. 9A).
+
+    Args:
+        displacement: imposed rod displacement [m]. velocity: rod speed [m/s]; slow for a
+            quasi-static response (use Cundall local damping 0.8).
+        height: height of the contact line above z = 0 [m]; default the centre of mass height.
+        direction: horizontal push direction (3,). rod_size: [m].
+        material: rod-specimen joint; default ``builder.default_material`` without friction or bond,
+            with a critically damping dashpot beta = 2 / omega, omega = sqrt(kn rod_size span / m).
+        name: rod block name.
+    """
+    from .geometry import box, mass_properties
+
+    if not (isinstance(displacement, (int, float)) and math.isfinite(displacement) and displacement > 0):
+        raise ValueError(f"pushover displacement must be a positive distance [m], got {displacement!r}")
+    if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
+        raise ValueError(f"pushover velocity must be a positive speed [m/s] (slow: quasi-static), got {velocity!r}")
+    if not (isinstance(rod_size, (int, float)) and math.isfinite(rod_size) and rod_size > 0):
+        raise ValueError(f"pushover rod_size must be a positive length [m], got {rod_size!r}")
+    d = _horizontal_unit(direction, builder.gravity, "pushover direction")
+    gn = float(np.linalg.norm(builder.gravity))
+    up = -builder.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
+    across = np.cross(up, d)
+    free = builder.block_names(driven=False)
+    if not free:
+        raise ValueError("pushover: the model has no free block to push")
+    verts = np.vstack([builder.block(n).vertices for n in free])
+    props = [mass_properties(builder.block(n), builder.density(n)) for n in free]
+    mass = sum(p.mass for p in props)
+    centre = sum(p.mass * p.centroid for p in props) / mass
+    zmin, zmax = float((verts @ up).min()), float((verts @ up).max())
+    h = float(centre @ up) if height is None else float(height)
+    if not (math.isfinite(h) and zmin + 0.5 * rod_size <= h <= zmax - 0.5 * rod_size):
+        raise ValueError(
+            f"pushover rod height {h!r} m must lie on the specimen, between {zmin + 0.5 * rod_size:.4g} "
+            f"and {zmax - 0.5 * rod_size:.4g} m (rod_size {rod_size} m)"
+        )
+    front = float((verts @ d).min())
+    lo, hi = float((verts @ across).min()), float((verts @ across).max())
+    span = hi - lo
+    rot = np.column_stack([d, across, up])
+    centre_rod = (front - 0.5 * rod_size) * d + 0.5 * (lo + hi) * across + h * up
+    poly = box(rod_size, span, rod_size, name=name).transformed(rot, centre_rod)
+    if material is None:
+        base = builder.default_material
+        if base is None:
+            raise ValueError("pushover rod: give material or set builder.default_material")
+        # critically damped rod contact (beta = 2 / omega of the specimen on the rod spring): the
+        # dashpot removes the chatter of the stiff rod contact; it does not bias the force, the
+        # rod and the face moving together in a quasi-static push
+        omega = math.sqrt(base.kn * rod_size * span / mass)
+        material = replace(base, friction_angle=0.0, cohesion=0.0, tension=0.0, residual_friction_angle=0.0, beta=2.0 / omega)
+    groups = {builder.group(n) for n in free}
+    for g in groups:
+        builder.set_material("pushover_rod", g, material)
+    # smooth start and stop (half-cosine speed ramps over 20 % of the push time each, no impact
+    # on the face); the ramps lose and gain the same distance, so displacement = velocity * push_time
+    push_time = displacement / velocity
+    tt = np.linspace(0.0, 0.2 * push_time, 41)
+    up_ = 0.5 * (1.0 - np.cos(np.pi * tt / tt[-1]))
+    times = np.r_[tt, push_time + tt]
+    speed = np.r_[up_, 1.0 - up_]
+    motion = Motion(times, np.outer(speed * velocity, d))
+    # one point across the rod: a line contact at the rod's centre height (a roller)
+    builder.add_block(poly, group="pushover_rod", name=name, driven=motion, points=(1, 3))
+    return RodPushover(name, float(velocity), float(displacement), h, d, mass * (gn or STANDARD_GRAVITY))
+
+
 def pushover(
     builder: ModelBuilder,
     *,
@@ -338,19 +462,21 @@ def capacity_curve(
     """Capacity curve of a pushover result: load factor lambda vs monitor displacement.
 
     Args:
-        ds: a result of :func:`pushover` or of a case with ``[loading] type = "pushover"``.
+        ds: a result of :func:`pushover`, of a run with :func:`apply_rod_pushover`, or of a case
+            with ``[loading] type = "pushover"``.
         monitor: monitor point name (default "top").
         direction: displacement component (3,); default the load direction (else +x).
         source: "ramp": lambda(t) of the applied ramp (from the attrs or ``rate`` and
-            ``max_load_factor``); "reaction": lambda = -R.d / (W) from the base reaction R and the
-            weight W of the free blocks (quasi-static equilibrium; includes inertia after the peak);
-            "auto": the ramp when known, else the reaction.
+            ``max_load_factor``); "rod": lambda = F.d / W from the pushing rod's force F
+            (displacement control); "reaction": lambda = -R.d / W from the base reaction R (quasi-
+            static equilibrium; includes inertia after the peak); W is the weight of the free
+            blocks. "auto": the rod when there is one, else the ramp when known, else the reaction.
 
     Returns:
         (load_factor (T,) [-], displacement (T,) [m]).
     """
-    if source not in ("auto", "ramp", "reaction"):
-        raise ValueError(f"source must be 'auto', 'ramp' or 'reaction', got {source!r}")
+    if source not in ("auto", "ramp", "rod", "reaction"):
+        raise ValueError(f"source must be 'auto', 'ramp', 'rod' or 'reaction', got {source!r}")
     a = ds.attrs
     rate = a.get("pushover_rate") if rate is None else rate
     lam_max = a.get("pushover_max_load_factor") if max_load_factor is None else max_load_factor
@@ -362,13 +488,19 @@ def capacity_curve(
     if monitor not in names:
         raise KeyError(f"no monitor {monitor!r} in the result; monitors are {names}")
     disp = ds.monitor_displacement.values[:, names.index(monitor), :] @ d
-    if source == "ramp" or (source == "auto" and rate is not None):
+    g = float(a.get("pushover_gravity", np.linalg.norm(a.get("gravity", (0.0, 0.0, -STANDARD_GRAVITY)))))
+    weight = float(a.get("pushover_weight", ds.block_mass.values[ds.block_free.values.astype(bool)].sum() * g))
+    rod = a.get("pushover_rod")
+    if source == "rod" or (source == "auto" and rod is not None):
+        if rod is None or "driven_reaction" not in ds:
+            raise ValueError("the result has no pushover rod (apply_rod_pushover / [loading] mode = 'displacement')")
+        k = [str(n) for n in ds.driven_block.values].index(str(rod))
+        lam = (ds.driven_reaction.values[:, k, :] @ d) / weight
+    elif source == "ramp" or (source == "auto" and rate is not None):
         if rate is None or lam_max is None:
             raise ValueError("the ramp is unknown: pass rate and max_load_factor, or use source='reaction'")
         lam = np.minimum(float(rate) * ds.time.values, float(lam_max))
     else:
-        g = float(a.get("pushover_gravity", np.linalg.norm(a.get("gravity", (0.0, 0.0, -STANDARD_GRAVITY)))))
-        weight = float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum()) * g
         lam = -(ds.base_reaction.values @ d) / weight
     return lam, disp
 
@@ -438,19 +570,47 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
         delay=t.number("delay", 0.0, min_=0.0),
     )
     ctx["earthquake"] = info
+    ctx["attrs"].update(
+        earthquake_record=info.motion.name,
+        earthquake_mode=info.mode,
+        earthquake_pga_m_s2=info.pga,
+        earthquake_duration_s=float(info.time[-1]),
+    )
+    ctx["series"]["ground_acceleration"] = (info.time, info.acceleration)
 
 
 @loading("pushover")
 def _pushover(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
-    """Quasi-static pushover: lateral body acceleration lambda(t) g d, lambda = min(rate t, max).
+    """Quasi-static pushover, load or displacement controlled (set ``[damping] local = 0.8``).
 
-    Keys: rate [1/s] (default 0.1), max_load_factor (required), direction (default [1, 0, 0]).
-    Set ``[damping] local = 0.8`` for a quasi-static response (Cundall's local damping).
+    Keys: mode ("load", default, or "displacement"), direction (default [1, 0, 0]).
+    Load control: lateral body acceleration lambda(t) g d, lambda = min(rate t, max_load_factor);
+    keys rate [1/s] (default 0.1), max_load_factor (required).
+    Displacement control: a frictionless rod pushes the specimen (see :func:`apply_rod_pushover`);
+    keys displacement [m] (required), velocity [m/s] (default displacement / 10 s), rod_height [m]
+    (default the centre of mass height), rod_size [m] (0.02). Monitor ``rod`` follows the rod.
     """
-    ramp = apply_pushover(
+    mode = t.string("mode", "load", choices=("load", "displacement"))
+    direction = t.vector("direction", (1.0, 0.0, 0.0))
+    if mode == "load":
+        ramp = apply_pushover(
+            b,
+            rate=t.number("rate", 0.1, positive=True),
+            max_load_factor=t.number("max_load_factor", positive=True),
+            direction=direction,
+        )
+        ctx["pushover"] = ramp
+        ctx["attrs"].update(ramp.attrs())
+        return
+    disp = t.number("displacement", positive=True)
+    rod = apply_rod_pushover(
         b,
-        rate=t.number("rate", 0.1, positive=True),
-        max_load_factor=t.number("max_load_factor", positive=True),
-        direction=t.vector("direction", (1.0, 0.0, 0.0)),
+        displacement=disp,
+        velocity=t.number("velocity", disp / 10.0, positive=True),
+        height=t.optional_number("rod_height", positive=True),
+        direction=direction,
+        rod_size=t.number("rod_size", 0.02, positive=True),
     )
-    ctx["pushover"] = ramp
+    monitors["rod"] = (rod.rod, tuple(b.block(rod.rod).vertices.mean(axis=0)))
+    ctx["pushover"] = rod
+    ctx["attrs"].update(rod.attrs())

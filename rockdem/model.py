@@ -280,37 +280,81 @@ class ModelBuilder:
         blk = self._blocks[self._index(i)]
         blk.poly = blk.poly.transformed(r, a - r @ a + np.asarray(translation, dtype=float))
 
-    def tilt(self, i: int | str, fraction: float, *, direction: ArrayLike = (1.0, 0.0, 0.0)) -> float:
-        """Tilt block ``i`` about its base edge on the ``direction`` side to ``fraction`` of its
-        instability angle (free rocking from a fraction of the instability displacement, paper §3.1).
+    def group(self, i: int | str) -> str:
+        """Joint-material group of block ``i`` (id or name)."""
+        return self._blocks[self._index(i)].group
 
-        The pivot is the lowest edge of the block furthest along the horizontal ``direction``; the
-        block turns about it so that its top moves towards ``direction``. Returns the tilt angle [rad].
+    def density(self, i: int | str) -> float:
+        """Density of block ``i`` (id or name) [kg/m^3]."""
+        return self._blocks[self._index(i)].density
+
+    def block_names(self, *, driven: bool | str | None = None) -> list[str]:
+        """Names of the blocks added so far: all (``driven=None``), the free ones (``False``), the
+        driven ones (``True``: fixed, ground-following or with a prescribed motion) or those that
+        follow the ground motion (``"ground"``)."""
+        if driven is None:
+            return [b.name for b in self._blocks]
+        if driven is False:
+            return [b.name for b in self._blocks if b.driven is False]
+        if driven is True:
+            return [b.name for b in self._blocks if b.driven is not False]
+        if driven == GROUND:
+            return [b.name for b in self._blocks if isinstance(b.driven, str) and b.driven == GROUND]
+        raise ValueError(f"driven must be None, False, True or 'ground', got {driven!r}")
+
+    def tilt(
+        self,
+        i: int | str | Sequence[int | str],
+        fraction: float,
+        *,
+        direction: ArrayLike = (1.0, 0.0, 0.0),
+    ) -> float:
+        """Tilt block ``i`` (or the blocks ``i``, as one rigid assembly) about the base edge on the
+        ``direction`` side to ``fraction`` of the instability angle (free rocking from a fraction
+        of the instability displacement, paper §3.1 and §3.2).
+
+        The pivot is the lowest edge of the block (assembly) furthest along the horizontal
+        ``direction``; the assembly turns about it so that its top moves towards ``direction``.
+        The instability angle is that of the assembly's centre of mass about the pivot, so a
+        discretised wall is released exactly as the equivalent single block. Returns the tilt
+        angle [rad].
         """
-        blk = self._blocks[self._index(i)]
-        if not (math.isfinite(fraction) and 0.0 <= fraction):
-            raise ValueError(f"tilt fraction must be >= 0, got {fraction!r}")
-        d = np.asarray(direction, dtype=float)
-        up = -self.gravity / np.linalg.norm(self.gravity) if np.linalg.norm(self.gravity) > 0 else np.array([0, 0, 1.0])
+        ids = [self._index(i)] if isinstance(i, (str, int, np.integer)) else [self._index(k) for k in i]
+        if not ids:
+            raise ValueError("tilt: give at least one block")
+        if len(set(ids)) != len(ids):
+            raise ValueError("tilt: a block is listed twice")
+        blocks = [self._blocks[k] for k in ids]
+        driven = [b.name for b in blocks if b.driven is not False]
+        if driven:
+            raise ValueError(f"tilt: blocks {driven} are driven; only free blocks can be tilted")
+        if not (isinstance(fraction, (int, float)) and math.isfinite(fraction) and 0.0 <= fraction):
+            raise ValueError(f"tilt fraction must be >= 0 (0.9 = 90 % of the instability angle), got {fraction!r}")
+        d = np.asarray(direction, dtype=float).reshape(3)
+        gn = np.linalg.norm(self.gravity)
+        up = -self.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
         d = d - up * (up @ d)
-        if np.linalg.norm(d) == 0:
+        if not np.linalg.norm(d) > 0:
             raise ValueError("tilt direction must have a horizontal component")
         d /= np.linalg.norm(d)
-        v = blk.poly.vertices
+        v = np.vstack([b.poly.vertices for b in blocks])
+        size = max(b.poly.size for b in blocks)
         h = v @ up
-        base = v[h <= h.min() + 1e-9 * blk.poly.size]
+        base = v[h <= h.min() + 1e-9 * size]
         along = base @ d
-        pivot = base[along >= along.max() - 1e-9 * blk.poly.size].mean(axis=0)
-        c = mass_properties(blk.poly, blk.density).centroid
+        pivot = base[along >= along.max() - 1e-9 * size].mean(axis=0)
+        props = [mass_properties(b.poly, b.density) for b in blocks]
+        mass = sum(p.mass for p in props)
+        c = sum(p.mass * p.centroid for p in props) / mass
         rel = c - pivot
         eta = math.atan2(max(float(-(rel @ d)), 0.0), float(rel @ up))
         theta = fraction * eta
-        axis = np.cross(up, d)
-        r = axis_angle_matrix(axis, theta)
-        if blk.reference is None:
-            blk.reference = blk.poly
-        self.transform_block(i, r, about=pivot)
-        blk.tilt = r @ blk.tilt
+        r = axis_angle_matrix(np.cross(up, d), theta)
+        for k, blk in zip(ids, blocks):
+            if blk.reference is None:
+                blk.reference = blk.poly
+            self.transform_block(k, r, about=pivot)
+            blk.tilt = r @ blk.tilt
         return theta
 
     # -- materials and loading ----------------------------------------------------------------

@@ -11,6 +11,7 @@ Variables (dims; units in each variable's ``units`` attribute):
   monitor_displacement (time, monitor, xyz) [m] from the monitor's reference (untilted) position
   contacts_active / _bonded / _failed_tension / _failed_shear (time) [-]  sub-contact counts
   base_reaction (time, xyz) [N]                force of the driven blocks on the free blocks
+  driven_reaction (time, driven_block, xyz) [N] the same, per driven block (foundation, rods, ...)
   energy_* and work_* (time) [J], energy_balance_error (time) [J], energy_balance_error_relative
   static: block_mass, block_free, block_group, block_name (block); the geometry for plots and
   VTK: vertex_local (vertex, xyz) [m] in the body frames, face_vertex (corner) global vertex ids,
@@ -75,6 +76,13 @@ def build_dataset(
     for k, name in enumerate(COUNT_NAMES):
         ds[name] = ("time", rec.counts[:, k], {"units": "1"})
     ds["base_reaction"] = (("time", "xyz"), rec.reaction, {"units": "N"})
+    driven = np.flatnonzero(~model.arrays.block_free.astype(bool))
+    ds = ds.assign_coords(driven_block=("driven_block", np.array([model.block_names[b] for b in driven], dtype=object)))
+    ds["driven_reaction"] = (
+        ("time", "driven_block", "xyz"),
+        rec.driven_reaction,
+        {"units": "N", "note": "contact force of each driven block on the free blocks"},
+    )
     energy = rec.energy.copy()
     if len(t):
         energy[:, E_POTENTIAL] -= energy[0, E_POTENTIAL]
@@ -165,8 +173,9 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out = ds.copy()
     for name in ("block_group", "block_name"):
         out[name] = out[name].astype(str)
-    if "monitor" in out.coords:
-        out = out.assign_coords(monitor=out.monitor.astype(str))
+    for coord in ("monitor", "driven_block"):
+        if coord in out.coords:
+            out = out.assign_coords({coord: out[coord].astype(str)})
     out["block_free"] = out["block_free"].astype(np.int8)
     out.to_netcdf(p, encoding=enc)
     return p

@@ -18,9 +18,13 @@ __all__ = ["run_case", "register_cli", "summary_lines"]
 
 
 def run_case(case: Case, *, duration: float | None = None, progress: bool | None = None) -> xr.Dataset:
-    """Run a built case with its own options (``duration`` overrides [run] duration)."""
+    """Run a built case with its own options (``duration`` overrides [run] duration).
+
+    The loading's attributes (``case.attrs``) go into the result's attrs, its input series
+    (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
+    """
     r = case.run
-    return simulate(
+    ds = simulate(
         case.model,
         duration if duration is not None else r.duration,
         dt=r.dt,
@@ -30,6 +34,12 @@ def run_case(case: Case, *, duration: float | None = None, progress: bool | None
         monitors=case.monitors,
         progress=progress,
     )
+    ds.attrs.update(case.attrs)
+    t = ds.time.values
+    for name, (ts, values) in case.series.items():
+        v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])
+        ds[name] = (("time", "xyz"), v, {"units": "m/s2" if "acceleration" in name else "1"})
+    return ds
 
 
 def summary_lines(ds: xr.Dataset) -> list[str]:
@@ -60,6 +70,11 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         f"{int(ds.contacts_failed_tension[-1])} in tension "
         f"({100 * int(ds.contacts_failed_tension[-1]) / npts:.1f} %) of {npts}"
     )
+    if int(a.get("tilted_blocks", 0)) > 1:
+        # a released assembly (e.g. a discretised wall): analyse a block of its base course
+        z0 = ds.block_position.values[0, free, 2]
+        b = int(free[int(np.argmin(z0))])
+        lines.append(f"analysed block   {ds.block_name.values[b]!s} (base of the released assembly of {a['tilted_blocks']} blocks)")
     lines.extend(_analysis_lines(ds, b))
     if a.get("interrupted"):
         lines.append("INTERRUPTED: the result holds the frames computed before the interruption")

@@ -80,7 +80,7 @@ def simulate(
     state.clock[1] = state.clock[2] = state.clock[4] = info.dt
     state.clock[3] = safety
     snaps.take(state)
-    rec = new_records(frames, model.block_count)
+    rec = new_records(frames, model.block_count, int(np.count_nonzero(~model.arrays.block_free.astype(bool))))
     m = model.arrays
     frame = 0
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time

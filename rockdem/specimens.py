@@ -293,6 +293,7 @@ def parapet(
     bond: str = "running",
     density: float = 1800.0,
     material: JointMaterial | None = None,
+    base_material: JointMaterial | None = None,
     points: tuple[int, int] | None = None,
 ) -> Monitors:
     """A free-standing URM parapet (Giaretton et al., paper §4.1) as one block or brick by brick.
@@ -316,6 +317,8 @@ def parapet(
         density: [kg/m^3].
         material: material of every joint (base, bed and head); None: ``builder.default_material``.
             For kn = E / l, l is the height (single block) or brick height (paper §3).
+        base_material: the parapet-foundation joint (e.g. the crushed soft mortar bed, without
+            bond); None: ``material``.
         points: interface points per face; default the builder's (single block) or (2, 3).
 
     Returns:
@@ -344,13 +347,14 @@ def parapet(
             bricks_per_course=nb,
             bond=bond,
             joint=material,
-            base=material,
+            base=material if base_material is None else base_material,
             density=density,
             points=points or (2, 3),
             base_reduction=red,
         )
     add_foundation(builder, 2.0 * max(t, ln, h))
-    _set_pairs(builder, [("block", "block"), ("block", "foundation"), ("foundation", "foundation")], material)
+    _set_pairs(builder, [("block", "block"), ("foundation", "foundation")], material)
+    _set_pairs(builder, [("block", "foundation")], material if base_material is None else base_material)
     poly = rounded_prism(t, ln, h, chamfer=0.5 * red, name="parapet") if red > 0 else box(t, ln, h, center=(0, 0, 0.5 * h), name="parapet")
     builder.add_block(poly, density=density, group="block", name="parapet", points=points)
     return {"top": ("parapet", (0.5 * t, 0.0, h))}
@@ -649,8 +653,9 @@ def _wall_case(t: Table, b: ModelBuilder) -> Monitors:
 @specimen("parapet")
 def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
     """Parapet. Keys: thickness, height, length, base_reduction [m], density, brick = [ly, lz]
-    (absent: single block "parapet"), bond, points_across, points_along and the joint keys
-    (kn = E / height, or E / brick height when discretised)."""
+    (absent: single block "parapet"), bond, points_across, points_along, the joint keys
+    (kn = E / height, or E / brick height when discretised) and optional [base] (the base joint;
+    default the joint keys' material)."""
     thickness = t.number("thickness", 0.23, positive=True)
     height = t.number("height", positive=True)
     length = t.number("length", 1.0, positive=True)
@@ -670,6 +675,7 @@ def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
         bond=bond,
         density=t.number("density", 1800.0, positive=True),
         material=mat,
+        base_material=_sub_material(t, "base", spacing=spacing),
         points=pts,
     )
 

@@ -1,12 +1,17 @@
 """Specimen builders: geometry, mass, bonded joints, short physics checks and the TOML forms."""
 
 
+import math
+
 import numpy as np
 import pytest
 
+from rockdem.analysis import summarize_result
 from rockdem.case import parse_case
+from rockdem.housner import HousnerBlock, quarter_period
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
+from rockdem.run_cli import run_case
 from rockdem.simulate import simulate
 from rockdem.specimens import brick_wall, facade, parapet, stacked_blocks, two_block_wall
 from rockdem.state import initial_state
@@ -188,3 +193,67 @@ def test_toml_wall_rejects_unknown_joint_key():
 def test_bad_input_names_the_field(call, field):
     with pytest.raises(ValueError, match=field):
         call(ModelBuilder())
+
+
+def _wall_case(**loading):
+    return {
+        "run": {"duration": 0.7, "record_interval": 0.005},
+        "specimen": {
+            "type": "wall", "brick": [0.11, 0.23, 0.076], "courses": 6, "bricks_per_course": 3,
+            "joint": {"youngs_modulus": 1.8e9, "friction_angle_deg": 31.0, "cohesion": 1e7, "tension": 1e7},
+            "base": {"youngs_modulus": 1.8e9, "friction_angle_deg": 31.0},
+        },
+        "loading": {"type": "free-rocking", **loading},
+    }
+
+
+def test_discretised_wall_is_released_as_one_rigid_assembly():
+    # Paper §3.2: the discretised block is released from 90 % of the instability angle of the
+    # whole wall, eta = atan(B / H) with H = 6 courses, about its +x base edge. Every brick gets
+    # the same initial rotation, the joints start bonded (no overlap, no gap), and with strong
+    # bonds the bricks rock together back towards the vertical.
+    case = parse_case(_wall_case(tilt_fraction=0.9))
+    eta = math.atan(0.11 / (6 * 0.076))
+    assert case.attrs["tilt_angle_rad"] == pytest.approx(0.9 * eta, rel=1e-12)
+    assert case.attrs["tilted_blocks"] == int(case.model.arrays.block_free.sum())
+    initial_state(case.model)  # raises on any overlap
+    ds = run_case(case, progress=False)
+    free = ds.block_free.values.astype(bool)
+    theta = ds.rocking_angle.values[:, free]
+    assert np.allclose(theta[0], 0.9 * eta, rtol=1e-9)
+    k = int(np.argmax(theta.mean(axis=1) <= 0.5 * 0.9 * eta))
+    assert k > 0 and np.ptp(theta[k]) < 0.02 * 0.9 * eta  # still one rigid body
+    # ... and the first impact comes at Housner's quarter period of the equivalent block (within
+    # 5 %: elastic joints and base; the rigid quarter period is 0.53 s)
+    t = ds.time.values
+    t_hit = t[np.argmax(theta.mean(axis=1) <= 0.0)]
+    assert t_hit == pytest.approx(quarter_period(HousnerBlock(0.11, 6 * 0.076), 0.9 * eta), rel=0.05)
+    assert int(ds.contacts_failed_tension.values[-1]) == 0 and int(ds.contacts_failed_shear.values[-1]) == 0
+    # the pivot stays put: the +x bottom corner of the base course does not move
+    pivot_block = int(np.flatnonzero(free)[np.argmin(ds.block_position.values[0, free, 2])])
+    s = summarize_result(ds)
+    assert s["eta_rad"] == pytest.approx(eta, rel=1e-9)
+    assert ds.block_position.values[0, pivot_block, 2] < 0.076
+
+
+def test_free_rocking_names_a_bad_block_and_refuses_driven_blocks():
+    with pytest.raises(ValueError, match=r"\[loading\] block: no block named \['nope'\]"):
+        parse_case(_wall_case(block="nope"))
+    with pytest.raises(ValueError, match="driven"):
+        parse_case(_wall_case(block=["foundation"]))
+
+
+def test_parapet_has_a_separate_base_joint():
+    # Paper §4.1: the discretised parapet's bed and head joints are bonded (c = 0.5 MPa,
+    # ft = 0.1 MPa); the base joint (crushed soft mortar) may be given its own, unbonded material.
+    for brick in (None, [0.23, 0.076]):
+        spec = {"type": "parapet", "height": 0.73, "length": 1.0, "youngs_modulus": 1.8e9,
+                "cohesion": 5e5, "tension": 1e5, "base": {"youngs_modulus": 1.8e9, "friction_angle_deg": 30.0}}
+        if brick:
+            spec["brick"] = brick
+        case = parse_case({"run": {"duration": 0.1}, "specimen": spec})
+        mats = case.model.materials
+        base = mats[("brick" if brick else "block", "foundation")]
+        assert base.cohesion == 0.0 and base.tension == 0.0 and base.friction_angle == 30.0
+        if brick:
+            assert mats[("brick", "brick")].cohesion == 5e5

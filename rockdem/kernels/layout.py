@@ -150,10 +150,11 @@ class Records(NamedTuple):
     energy: np.ndarray  # (R, ENERGY_COUNT)
     counts: np.ndarray  # (R, 4)
     reaction: np.ndarray  # (R, 3) [N] force of driven blocks on free blocks
+    driven_reaction: np.ndarray  # (R, nd, 3) [N] force of each driven block on the free blocks
 
 
-def new_records(count: int, blocks: int) -> Records:
-    """Zeroed record arrays for ``count`` frames."""
+def new_records(count: int, blocks: int, driven: int = 0) -> Records:
+    """Zeroed record arrays for ``count`` frames, ``blocks`` blocks of which ``driven`` driven."""
     return Records(
         np.zeros(count),
         np.zeros((count, blocks, 3)),
@@ -163,4 +164,5 @@ def new_records(count: int, blocks: int) -> Records:
         np.zeros((count, ENERGY_COUNT)),
         np.zeros((count, 4), dtype=np.int64),
         np.zeros((count, 3)),
+        np.zeros((count, driven, 3)),
     )

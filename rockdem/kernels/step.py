@@ -246,6 +246,7 @@ def integrate_velocities(
     e_loc = 0.0
     w_body = 0.0
     w_drv = 0.0
+    jd = 0
     for b in range(nb):
         r = sc.rotation[b]
         if m.block_free[b]:
@@ -293,6 +294,10 @@ def integrate_velocities(
                 interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * dt, vd)
             else:
                 vd[:] = 0.0
+            if frame >= 0:
+                for i in range(3):
+                    rec.driven_reaction[frame, jd, i] = -sc.force[b, i]
+            jd += 1
             for i in range(3):
                 w_drv -= sc.force[b, i] * vd[i] * dt
                 s.velocity[b, i] = vd[i]
