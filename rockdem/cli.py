@@ -14,6 +14,7 @@ _COMMAND_MODULES = (
     "rockdem.animate",
     "rockdem.vtk_export",
     "rockdem.studies",
+    "rockdem.reproduce",
 )
 
 
