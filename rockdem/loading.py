@@ -57,6 +57,7 @@ __all__ = [
     "apply_pushover",
     "RodPushover",
     "apply_rod_pushover",
+    "rigid_rod_load_factor",
     "pushover",
     "capacity_curve",
 ]
@@ -415,6 +416,20 @@ def apply_rod_pushover(
     # one point across the rod: a line contact at the rod's centre height (a roller)
     builder.add_block(poly, group="pushover_rod", name=name, driven=motion, points=(1, 3))
     return RodPushover(name, float(velocity), float(displacement), h, d, mass * (gn or STANDARD_GRAVITY))
+
+
+def rigid_rod_load_factor(b: float, h: float, z_rod: float, theta: ArrayLike) -> NDArray[np.float64]:
+    """Horizontal rod force / weight that holds a rigid b x h block at rotation ``theta`` [rad]
+    about its toe (moment balance of the weight and of a frictionless rod force normal to the
+    tilted pushed face, line of contact at height ``z_rod`` [m]). At theta = 0 it is b / (2 z_rod);
+    it reaches 0 at theta = atan(b / h). The reference curve of :func:`apply_rod_pushover`."""
+    th = np.asarray(theta, dtype=float)
+    c, s = np.cos(th), np.sin(th)
+    r_g = -0.5 * b * c + 0.5 * h * s  # lever arm (x) of the weight about the toe
+    up_face = (z_rod - b * s) / c  # distance of the contact point up the pushed face
+    r_x = -b * c + up_face * s
+    fn = -r_g / (z_rod * c + r_x * s)  # normal force per weight: the torques about the toe cancel
+    return fn * c
 
 
 def pushover(

@@ -14,7 +14,7 @@ import pytest
 
 from rockdem.case import load_case, parse_case
 from rockdem.kernels.rotation import quats_to_matrices
-from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, pushover, resolve_record
+from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, pushover, resolve_record, rigid_rod_load_factor
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.records import read_record
@@ -173,18 +173,6 @@ def _rod_pushover_case(b: float, h: float, rod_height: float, displacement: floa
     }
 
 
-def _rigid_rod_load_factor(b: float, h: float, z_rod: float, theta: np.ndarray) -> np.ndarray:
-    """Horizontal rod force / W holding a rigid block at rotation theta about its toe: moment
-    balance of the weight and of a frictionless rod force normal to the tilted face at z_rod."""
-    c, s = np.cos(theta), np.sin(theta)
-    r_g = -0.5 * b * c + 0.5 * h * s  # lever (x) of the weight about the toe
-    face = (z_rod - b * s) / c  # distance of the contact up the pushed face
-    r_x, r_z = -b * c + face * s, z_rod
-    n_x, n_z = c, -s  # force direction (into the block)
-    fn = -r_g / (r_z * n_x - r_x * n_z)  # per unit weight: torques about y cancel
-    return fn * n_x
-
-
 def test_displacement_controlled_pushover_follows_the_rigid_softening_branch():
     # A rod pushes a 0.3 x 1.2 m block (not the paper's) at 0.9 m height, below the top and not at
     # the centre of mass; displacement control follows the capacity curve past its peak, down to
@@ -198,7 +186,7 @@ def test_displacement_controlled_pushover_follows_the_rigid_softening_branch():
     ds = run_case(parse_case(_rod_pushover_case(b, h, z, disp, duration=20.0)), progress=False)
     lam, u = capacity_curve(ds)
     theta = ds.rocking_angle.values[:, 1]
-    expected = _rigid_rod_load_factor(b, h, z, theta)
+    expected = rigid_rod_load_factor(b, h, z, theta)
     sel = (theta > 0.15 * eta) & (theta < 0.9 * eta)
     assert sel.sum() > 50
     assert np.max(np.abs(lam[sel] - expected[sel])) < 0.02 * b / (2 * z)
