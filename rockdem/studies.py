@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import functools
 import hashlib
 import itertools
 import json
@@ -33,7 +34,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .case import LOADINGS, Table, apply_overrides, example_case, example_names, load_case, loading, parse_case
+from .case import apply_overrides, example_case, example_names, load_case, parse_case
 
 __all__ = [
     "RunSpec",
@@ -85,7 +86,8 @@ class RunSpec:
         overrides: ``(("table.key", value), ...)``, sorted by key (use :meth:`make`).
         duration: simulated time [s]; None keeps ``[run] duration`` of the case.
         record: ground-motion record (a name in the shared records folder, or a file path); when
-            given, the case's ``[loading]`` table is replaced by a ``type = "record"`` loading.
+            given, the case's ``[loading]`` becomes an ``earthquake`` loading of that record (the
+            base's earthquake keys kept if it has one, else ``mode = "inertial"``).
         pga_g: target peak ground acceleration of the record [g] (None: record unscaled).
         history: keep a decimated history (time, rotation, monitor displacement) in the row.
         history_interval: decimation of the history [s] (None: the case's record interval).
@@ -109,8 +111,9 @@ class RunSpec:
         return cls(base=base, overrides=items, **kwargs)
 
     def to_json(self) -> dict[str, Any]:
-        """Canonical JSON-able form (what the id hashes)."""
-        return {
+        """Canonical JSON-able form (what the id hashes; with a record, its file's sha1 too, so that
+        an edited record file is a new run)."""
+        out = {
             "base": self.base,
             "overrides": [[k, v] for k, v in self.overrides],
             "duration": self.duration,
@@ -119,6 +122,9 @@ class RunSpec:
             "history": self.history,
             "history_interval": self.history_interval,
         }
+        if self.record is not None:
+            out["record_sha1"] = _file_sha1(self.record)
+        return out
 
     @property
     def id(self) -> str:
@@ -140,13 +146,29 @@ class RunSpec:
         """The full case dict of this run."""
         data = copy.deepcopy(dict(self.base))
         if self.record is not None:
-            data["loading"] = {"type": "record", "record": self.record}
+            # the base case's earthquake settings (mode, direction, tail, ...) are kept; any other
+            # loading becomes the record as inertial body forces on the free blocks
+            load = data.get("loading", {})
+            load = dict(load) if load.get("type") == "earthquake" else {"type": "earthquake", "mode": "inertial"}
+            load["record"] = self.record
             if self.pga_g is not None:
-                data["loading"]["pga_g"] = self.pga_g
+                load.pop("scale", None)
+                load["pga_g"] = self.pga_g
+            data["loading"] = load
         data = apply_overrides(data, [f"{k}={_toml_value(v)}" for k, v in self.overrides])
         if self.duration is not None:
             data.setdefault("run", {})["duration"] = self.duration
         return data
+
+
+@functools.lru_cache(maxsize=256)
+def _file_sha1(record: str) -> str:
+    from .loading import resolve_record
+
+    try:
+        return hashlib.sha1(resolve_record(record).read_bytes()).hexdigest()
+    except (FileNotFoundError, ValueError):
+        return "missing"
 
 
 def _toml_value(v: Any) -> str:
@@ -231,38 +253,6 @@ def _safe_run(spec: RunSpec) -> dict[str, Any]:
         return run_spec(spec)
     except Exception as exc:  # noqa: BLE001 - a failed run is recorded, not fatal
         return {"id": spec.id, **spec.inputs, "status": "error", "error": f"{type(exc).__name__}: {exc}"}
-
-
-# --------------------------------------------------------------------------------------------------
-# ground-motion loading used by IDA specs
-# --------------------------------------------------------------------------------------------------
-def _record_loading(t: Table, b: Any, monitors: Any, ctx: dict[str, Any]) -> None:
-    """A ground-motion record applied as the inertial body force -m a_g(t) on every free block.
-
-    Keys: record (name in the shared ground-motion folder, or a file path), units (for files that
-    do not say), pga_g (scale to this PGA [g]), scale (factor, if no pga_g), direction (default +x).
-    """
-    from .records import read_record, shared_record_path
-
-    name = t.string("record")
-    units = t.raw("units", None)
-    pga_g = t.optional_number("pga_g", positive=True)
-    scale = t.number("scale", 1.0, positive=True)
-    d = t.vector("direction", (1.0, 0.0, 0.0))
-    path = Path(name)
-    if not path.is_file():
-        path = shared_record_path(name)
-    gm = read_record(path, units=units) if units is not None else read_record(path)
-    gm = gm.scaled_to_pga(pga_g * 9.80665) if pga_g is not None else gm.scaled(scale)
-    d = np.asarray(d, dtype=float) / np.linalg.norm(d)
-    time_ = gm.time
-    acc = -np.outer(gm.acceleration, d)
-    b.set_body_acceleration(time_, acc)
-    ctx["record"] = gm.name
-
-
-if "record" not in LOADINGS:
-    loading("record")(_record_loading)
 
 
 # --------------------------------------------------------------------------------------------------
