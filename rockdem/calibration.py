@@ -228,6 +228,10 @@ def calibrate(
         cands = [(float(res.fun), list(res.x))]
     best_w, best_x = min(cands, key=lambda c: c[0])
     best_v = to_v(best_x)
+    # rocking WME surfaces are rough: the optimiser's last point is not always its best one
+    top = min(evals, key=lambda e: e["wme"])
+    if top["wme"] < best_w:
+        best_w, best_v = float(top["wme"]), [float(top[k]) for k in keys]
     result = CalibrationResult(keys, dict(zip(keys, best_v)), float(best_w), pd.DataFrame(evals))
     if len(keys) == 1 and curve:
         steps = [0.0, *SENSITIVITY_STEPS]
