@@ -46,3 +46,13 @@ def test_cli_reports_bad_case_without_traceback(tmp_path, capsys):
     assert "[specimen]" in err and "height is required" in err
     assert "Traceback" not in err
     assert main(["run", str(tmp_path / "missing.toml")]) == 2
+
+
+def test_package_root_exports_the_api():
+    import rockdem
+
+    for name in rockdem.__all__:
+        assert getattr(rockdem, name) is not None
+    assert rockdem.ModelBuilder is __import__("rockdem.model", fromlist=["ModelBuilder"]).ModelBuilder
+    with pytest.raises(AttributeError, match="no attribute 'nope'"):
+        rockdem.nope  # noqa: B018
