@@ -77,7 +77,7 @@ class Bouncing:
         start: (k,) take-off times [s].
         duration: (k,) airborne durations [s].
         amplitude: (k,) maximum height above the contact level [m].
-        magnitude: (k,) amplitude / duration [m/s].
+        magnitude: (k,) (amplitude - tol) / duration [m/s].
         max_magnitude: largest magnitude [m/s] (0 without any airborne phase).
     """
 
@@ -284,7 +284,9 @@ def bouncing(
     The block is airborne while d = z - z_contact exceeds ``tol``, with z_contact either an array
     (the height the measured point would have in contact, e.g. the centroid's rest height plus
     :func:`rocking_lift`) or the constant ``z_rest``. For each airborne phase: amplitude = max d,
-    duration = time above tol, magnitude = amplitude / duration. Pass the height of the block's
+    duration = time above tol, magnitude = (amplitude - tol) / duration (the paper's amplitude over
+    time aloft, measured above the threshold so that phases grazing it do not give spurious large
+    ratios; the same as amplitude / duration for flights well above tol). Pass the height of the block's
     lowest point (:func:`lowest_point_height`) with its ground level as ``z_rest``, or the centroid
     with ``z_contact``: the centroid alone also rises by plain rocking, which is not bouncing.
 
@@ -328,7 +330,10 @@ def bouncing(
         du.append(tb - ta)
         am.append(float(d[i0:i1].max()))
     du_a, am_a = np.array(du), np.array(am)
-    mag = am_a / du_a if len(du) else np.zeros(0)
+    # the rise above the threshold over the time above it: a phase that just grazes the threshold
+    # (an elastic rattle at the contact level) has both -> 0 and a magnitude -> 0, as a free flight
+    # of apex delta has delta / (2 sqrt(2 delta / g)) -> 0; amplitude / duration would blow up
+    mag = (am_a - tol) / du_a if len(du) else np.zeros(0)
     return Bouncing(np.array(st), du_a, am_a, mag, float(mag.max()) if len(mag) else 0.0)
 
 

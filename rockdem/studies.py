@@ -196,7 +196,8 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     Row keys: ``id``, the inputs (override keys, duration, record, pga_g), ``status`` ("ok"),
     ``max_rotation_rad``, ``max_rotation_over_eta``, ``overturned``, ``residual_rad``,
     ``residual_disp_m`` / ``max_disp_m`` (first monitor, horizontal), ``e_a_mean``,
-    ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``,
+    ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``
+    (the starting timestep), ``dt_min`` (the smallest, after any lowering at contact detections),
     ``runtime_s`` (engine), ``wall_s`` (whole run), and ``history`` when asked for.
     """
     from .analysis import summarize_result
@@ -234,6 +235,7 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     row["failed_tension_fraction"] = int(ds.contacts_failed_tension.values[-1]) / npts
     row["steps"] = int(a["steps"])
     row["dt"] = float(a["dt"])
+    row["dt_min"] = float(a["dt_min"])
     row["runtime_s"] = float(a["runtime_s"])
     if spec.history:
         step = 1

@@ -199,3 +199,19 @@ def test_summarize_result_on_a_dataset() -> None:
         summarize_result(ds.drop_vars("rocking_angle"))
     with pytest.raises(ValueError, match="out of range"):
         summarize_result(ds, block=5)
+
+
+def test_bouncing_ignores_phases_that_graze_the_threshold() -> None:
+    # An elastic rattle that lifts the lowest point 0.1 um above a 10 um threshold for a few
+    # microseconds is not a flight. Measured from the ground, amplitude / duration would be 0.26 m/s
+    # (duration 40 us from the interpolated crossings); above the threshold it is 2.5 mm/s, half the
+    # sampled rise rate of the point, while a real 0.2 mm flight keeps amplitude / duration.
+    t = np.array([0.0, 0.002, 0.004, 0.006])
+    z = np.array([0.0, 1.01e-5, 0.0, 0.0])
+    bo = bouncing(t, z, z_rest=0.0, tol=1e-5)
+    assert len(bo.magnitude) == 1 and bo.max_magnitude < 0.003
+    g, v = 9.81, 0.063  # apex v^2 / 2g = 0.2 mm, flight 2 v / g = 12.8 ms
+    t = np.arange(0.0, 0.05, 1e-4)
+    z = np.clip(v * (t - 0.01) - 0.5 * g * (t - 0.01) ** 2, 0.0, None) * (t > 0.01)
+    bo = bouncing(t, z, z_rest=0.0, tol=1e-5)
+    assert bo.max_magnitude == pytest.approx(v**2 / (2 * g) / (2 * v / g), rel=0.1)
