@@ -388,8 +388,10 @@ class ModelBuilder:
         Args:
             damping: Rayleigh / local damping.
             contact_tolerance: gap [m] within which sub-contacts are tracked between detections;
-                default 1 % of the smallest dimension of the free blocks. The point-in-face test
-                uses a tenth of it plus the point's own penetration.
+                default 1 % of the smallest dimension of the free blocks, and at least 1.5 times
+                the largest elastic opening or slip of a bonded joint at its strength (ft / kn,
+                c / ks), so that a bond is never lost to the tolerance before it breaks. The
+                point-in-face test uses it plus the point's own penetration.
             rocking_axis: world axis of the recorded ``rocking_angle`` (default y: rocking in x-z).
         """
         if not self._blocks:
@@ -499,7 +501,13 @@ class ModelBuilder:
 
         free_mask = np.array([blk.driven is False for blk in self._blocks])
         if contact_tolerance is None:
-            contact_tolerance = 0.01 * min_dim
+            # a bonded point must stay tracked until its bond breaks: at least 1.5 x the elastic
+            # opening at the tensile strength (ft / kn) and slip at the cohesion (c / ks)
+            opening = max(
+                (max(m_.tension / m_.kn, m_.cohesion / m_.shear_stiffness) for m_ in mats.values() if m_.bonded),
+                default=0.0,
+            )
+            contact_tolerance = max(0.01 * min_dim, 1.5 * opening)
         if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
             raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
         motion_t = np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0)
