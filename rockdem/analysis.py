@@ -393,6 +393,10 @@ def rocking_onset_time(t: ArrayLike, theta: ArrayLike, threshold: float) -> floa
     return float(t[above[0]]) if len(above) else None
 
 
+SUMMARY_PEAK_PROMINENCE = 0.02
+"""Smallest half-cycle peak counted by :func:`summarize`, as a fraction of the largest rotation."""
+
+
 def summarize(
     t: ArrayLike,
     theta: ArrayLike,
@@ -425,7 +429,9 @@ def summarize(
     }
     thr = onset_threshold if onset_threshold is not None else (0.01 * eta if eta else 1e-3)
     out["onset_time_s"] = rocking_onset_time(t, th, thr)
-    pk = half_cycle_peaks(t, th)
+    # half cycles of rocking reach back to ~0, so their prominence is their height; 2 % of the largest
+    # rotation keeps every real half cycle but not the vibration of a brick riding on a rocking wall
+    pk = half_cycle_peaks(t, th, min_prominence=SUMMARY_PEAK_PROMINENCE * max_rotation(th))
     out["half_cycles"] = int(len(pk.value))
     if eta is not None:
         out["eta_rad"] = float(eta)

@@ -76,6 +76,8 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         b = int(free[int(np.argmin(z0))])
         lines.append(f"analysed block   {ds.block_name.values[b]!s} (base of the released assembly of {a['tilted_blocks']} blocks)")
     lines.extend(_analysis_lines(ds, b))
+    if a.get("diverged"):
+        lines.append(f"DIVERGED at t = {a['diverged_time']:.4g} s: the result holds the sound frames before it")
     if a.get("interrupted"):
         lines.append("INTERRUPTED: the result holds the frames computed before the interruption")
     return lines

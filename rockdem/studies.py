@@ -59,6 +59,8 @@ TIMING_COLUMNS = ("runtime_s", "wall_s")
 """Row entries that measure time and therefore differ between otherwise identical runs."""
 
 EXECUTORS = ("process", "serial", "dask")
+FINISHED = ("ok", "diverged")
+"""Row statuses of finished runs (a diverged run is deterministic: rerunning it gives the same row)."""
 
 
 # --------------------------------------------------------------------------------------------------
@@ -193,7 +195,9 @@ def _block_eta(data: Mapping[str, Any]) -> float | None:
 def run_spec(spec: RunSpec) -> dict[str, Any]:
     """Run one spec and return its summary row (pure: same spec -> same row, timings aside).
 
-    Row keys: ``id``, the inputs (override keys, duration, record, pga_g), ``status`` ("ok"),
+    Row keys: ``id``, the inputs (override keys, duration, record, pga_g), ``status`` ("ok", or
+    "diverged" with ``diverged_time_s`` when the engine's divergence check cut the run short: the
+    summary then covers the sound part),
     ``max_rotation_rad``, ``max_rotation_over_eta``, ``overturned``, ``residual_rad``,
     ``residual_disp_m`` / ``max_disp_m`` (first monitor, horizontal), ``e_a_mean``,
     ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``
@@ -219,8 +223,11 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     theta = np.asarray(ds.rocking_angle.values[:, b], dtype=float)
     a = ds.attrs
     npts = max(int(a.get("point_count", 1)), 1)
-    row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "ok"}
+    row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "diverged" if ds.attrs.get("diverged") else "ok"}
+    if ds.attrs.get("diverged"):
+        row["diverged_time_s"] = float(ds.attrs["diverged_time"])
     row["max_rotation_rad"] = float(s["max_rotation_rad"])
+    eta = eta or s.get("eta_rad")  # a released assembly: the assembly's angle (summarize_result)
     row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
     row["overturned"] = bool(s.get("overturned", False))
     row["residual_rad"] = float(s["residual_rad"])
@@ -264,7 +271,7 @@ class Store:
     """Append-only JSON-lines store of finished rows, one line per run, fsynced at once.
 
     Reading tolerates a truncated or corrupt last line (an interrupted write). When an id appears
-    several times (an error retried), the last "ok" row wins.
+    several times (an error retried), the last finished ("ok" or "diverged") row wins.
     """
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
@@ -288,13 +295,13 @@ class Store:
                 if not isinstance(row, dict) or "id" not in row:
                     continue
                 old = by_id.get(row["id"])
-                if old is None or old.get("status") != "ok":
+                if old is None or old.get("status") not in FINISHED:
                     by_id[row["id"]] = row
         return list(by_id.values())
 
     def done_ids(self) -> set[str]:
         """Ids of the runs finished successfully."""
-        return {r["id"] for r in self.rows() if r.get("status") == "ok"}
+        return {r["id"] for r in self.rows() if r.get("status") in FINISHED}
 
     def append(self, row: Mapping[str, Any]) -> None:
         """Append one row and make it durable (flush + fsync)."""
@@ -389,7 +396,7 @@ def execute(
         unique.setdefault(s.id, s)
     st = Store(store) if store is not None and not isinstance(store, Store) else store
     stored = {r["id"]: r for r in st.rows()} if st is not None else {}
-    done = {i for i, r in stored.items() if r.get("status") == "ok"}
+    done = {i for i, r in stored.items() if r.get("status") in FINISHED}
     todo = [s for i, s in unique.items() if i not in done]
     results: dict[str, dict[str, Any]] = {i: stored[i] for i in unique if i in done}
     from tqdm.auto import tqdm
@@ -620,8 +627,9 @@ def _sweep(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
                    progress=not args.no_progress)
-    n_err = int((df["status"] != "ok").sum()) if "status" in df else 0
-    print(f"{len(df)} runs ({n_err} failed) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
+    n_err = int((df["status"] == "error").sum()) if "status" in df else 0
+    n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0
+    print(f"{len(df)} runs ({n_err} failed, {n_div} diverged) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
     return 0 if n_err == 0 else 1
 
 

@@ -2,6 +2,8 @@
 
 import math
 
+import numpy as np
+
 import pytest
 
 from conftest import rocking_block
@@ -82,3 +84,20 @@ def test_unknown_top_level_table():
     data["dampin"] = {"beta": 0.1}
     with pytest.raises(ValueError, match=r"\[case\] unknown key\(s\) \['dampin'\]"):
         parse_case(data)
+
+
+def test_divergence_check_cuts_a_blown_up_run_and_passes_a_sound_one():
+    # A sound run keeps its energy balance (error ~1e-3 of the energy scale): no divergence. A run
+    # whose balance breaks (here injected: 50 J appear from nothing at frame k) or whose state is no
+    # longer finite is cut at the first bad frame (the engine then warns and keeps the frames before).
+    from rockdem.simulate import first_diverged_frame
+
+    ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.3, record_interval=0.01)
+    assert first_diverged_frame(ds) is None and "diverged" not in ds.attrs
+    k = 17
+    bad = ds.copy(deep=True)
+    bad["energy_balance_error"].values[k:] += 50.0
+    assert first_diverged_frame(bad) == k
+    bad = ds.copy(deep=True)
+    bad["block_position"].values[k + 3, 1, 0] = np.nan
+    assert first_diverged_frame(bad) == k + 3

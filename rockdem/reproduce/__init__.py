@@ -62,6 +62,7 @@ class Context:
 
     def execute(self, name: str, specs: Sequence[RunSpec]) -> list[dict[str, Any]]:
         """Run ``specs`` (skipping those finished in the store ``cache/name.jsonl``); rows in order.
+        A run cut short by the engine's divergence check comes back with status "diverged".
 
         Raises:
             RuntimeError: naming the first failed run (a reproduction needs every run).
@@ -69,7 +70,7 @@ class Context:
         self.cache.mkdir(parents=True, exist_ok=True)
         rows = execute(specs, self.cache / f"{name}.jsonl", executor=self.executor, workers=self.workers,
                        scheduler=self.scheduler, progress=self.progress)
-        bad = [r for r in rows if r.get("status") != "ok"]
+        bad = [r for r in rows if r.get("status") not in ("ok", "diverged")]
         if bad:
             raise RuntimeError(f"{name}: {len(bad)} run(s) failed, e.g. {bad[0].get('error')} (inputs {_inputs(bad[0])})")
         return rows
