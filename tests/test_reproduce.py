@@ -38,3 +38,19 @@ def test_table2_reduced_pushover_and_free_rocking(tmp_path):
     stored = (tmp_path / "cache" / "table2.jsonl").read_text()
     run_reproduction("table2", ctx)
     assert (tmp_path / "cache" / "table2.jsonl").read_text() == stored
+
+
+def test_fig5_7_reduced_bouncing(tmp_path):
+    # Paper §3.1 (Fig. 5B): SP-damped blocks do not bounce, MP-damped ones may; §3.2.1 (Fig. 7A):
+    # discretised undamped blocks bounce too. Every run of fig4 and table1 appears once.
+    ctx = Context(out=tmp_path / "out", cache=tmp_path / "cache", reduced=True, executor="process", workers=2, progress=False)
+    rep = run_reproduction("fig5_7", ctx)
+    t = rep.table
+    assert set(t["run"]) == {"MP (matched alpha)", "SP (DeJong beta)", "discretised, no damping"}
+    sp = t[t["run"] == "SP (DeJong beta)"]["bouncing [m/s]"].to_numpy()
+    mp = t[t["run"] == "MP (matched alpha)"]["bouncing [m/s]"].to_numpy()
+    assert len(sp) == len(mp) >= 2 and (sp <= mp + 1e-12).all()
+    assert (sp < 1e-3).all()  # no visible SP bouncing
+    dis = t[t["run"] == "discretised, no damping"]
+    assert len(dis) >= 2 and (dis["paper: bouncing critical (eta/R > 45 deg/m)"]).all()  # the squat 0.19 x 0.5 block
+    assert (tmp_path / "out" / "fig5_7.png").exists()
