@@ -274,10 +274,9 @@ direction; its line also includes the experimental matches of §4 (see the Fig. 
 nearly as well or better): {z}. These are the squattest blocks, at or above the paper's practical bouncing
 limit eta/R = 45 deg/m, as in the paper, where the alpha = 0 matches were the low-beta SP runs whose MP
 counterparts bounced (Fig. 5B). Cases flagged in the table (open markers) are left out of the Fig. 16 fit.
-The largest MP bouncing magnitudes (:func:`rockdem.analysis.bouncing`, airborne amplitude / duration): {top};
-the SP runs bounce at most {df['bounce_sp'].max():.3g} m/s. Treat the MP values with care: the largest ones come
-from airborne phases that barely exceed the 10 um threshold for a few microseconds (amplitude / duration of
-1e-5 m / 2e-6 s), not from visible bouncing. The eta = 35 deg block (0.35 x 0.5 m), which the paper dropped
+The largest MP bouncing magnitudes (:func:`rockdem.analysis.bouncing`: rise of the lowest point above a
+10 um airborne threshold over the time aloft): {top}; the SP runs bounce at most {df['bounce_sp'].max():.3g} m/s
+(see the fig5_7 report for all runs against eta/R). The eta = 35 deg block (0.35 x 0.5 m), which the paper dropped
 because it bounced away, is run here and flagged; its MP runs end with the top corner
 {1e2 * df.loc[sq, 'residual_mp'].abs().min():.1f} to {1e2 * df.loc[sq, 'residual_mp'].abs().max():.1f} cm from where it started (SP: 0),
 so it walks but does not bounce away.
