@@ -27,7 +27,7 @@ from typing import Any
 
 import pandas as pd
 
-from ..studies import RunSpec, execute
+from ..studies import RunSpec, Store, execute
 
 __all__ = ["Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
 
@@ -59,6 +59,8 @@ class Context:
     workers: int | None = None
     scheduler: Any = None
     progress: bool = True
+    computed: int = 0
+    reused: int = 0
 
     def execute(self, name: str, specs: Sequence[RunSpec]) -> list[dict[str, Any]]:
         """Run ``specs`` (skipping those finished in the store ``cache/name.jsonl``); rows in order.
@@ -68,7 +70,12 @@ class Context:
             RuntimeError: naming the first failed run (a reproduction needs every run).
         """
         self.cache.mkdir(parents=True, exist_ok=True)
-        rows = execute(specs, self.cache / f"{name}.jsonl", executor=self.executor, workers=self.workers,
+        store = Store(self.cache / f"{name}.jsonl")
+        done = store.done_ids()
+        ids = {s.id for s in specs}
+        self.reused += len(ids & done)
+        self.computed += len(ids - done)
+        rows = execute(specs, store, executor=self.executor, workers=self.workers,
                        scheduler=self.scheduler, progress=self.progress)
         bad = [r for r in rows if r.get("status") not in ("ok", "diverged")]
         if bad:
@@ -175,7 +182,8 @@ def write_report(report: Report, ctx: Context) -> list[Path]:
         "",
         f"Written by `rockdem reproduce {report.name}{' --reduced' if ctx.reduced else ''}` ({version}), rockdem {__version__}, "
         f"on {_dt.date.today().isoformat()}: **{report.runtime_s:.0f} s** wall time on {_machine()}"
-        f" (executor {ctx.executor}{'' if ctx.workers is None else f', {ctx.workers} workers'}).",
+        f" (executor {ctx.executor}{'' if ctx.workers is None else f', {ctx.workers} workers'}); "
+        f"{ctx.computed} runs computed, {ctx.reused} reused from the study stores.",
         "",
     ]
     lines += [f"![{f}]({f})" for f in report.figures]
@@ -209,6 +217,7 @@ def run_reproduction(name: str, ctx: Context) -> Report:
     if name not in REPRODUCTIONS:
         raise ValueError(f"unknown study {name!r}; studies are {sorted(REPRODUCTIONS)} (or 'all')")
     t0 = time.perf_counter()
+    ctx.computed = ctx.reused = 0
     report = REPRODUCTIONS[name].run(ctx)
     report.runtime_s = time.perf_counter() - t0
     write_report(report, ctx)

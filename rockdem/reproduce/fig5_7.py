@@ -60,7 +60,7 @@ def fig5_7(ctx: Context) -> Report:
             mk, c = styles[kind]
             ax.scatter(g["eta/R [deg/m]"], 1e3 * g["bouncing [m/s]"], marker=mk, color=c, label=kind, s=28, alpha=0.8)
         ax.axvspan(paper.BOUNCING_CRITICAL_ETA_OVER_R, max(130.0, t["eta/R [deg/m]"].max() * 1.05), color="0.9",
-                   label="paper: bouncing critical (> 45 deg/m)")
+                   label="paper: bouncing critical (> 45 deg/m)", zorder=0)
         ax.set(xlabel="eta / R [deg/m]", title=title)
         ax.set_yscale("symlog", linthresh=1.0)
         ax.grid(True, alpha=0.3)
