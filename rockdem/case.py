@@ -253,10 +253,10 @@ def _free_rocking(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: 
     frac = t.number("tilt_fraction", 0.9, min_=0.0)
     d = t.vector("tilt_direction", (1.0, 0.0, 0.0))
     try:
-        ctx["tilt_angle"] = b.tilt(names, frac, direction=d)
+        angle = b.tilt(names, frac, direction=d)
     except ValueError as exc:
         raise ValueError(f"[{t.where}] {exc}") from None
-    ctx["attrs"].update(tilt_angle_rad=ctx["tilt_angle"], tilt_fraction=frac, tilted_blocks=len(names))
+    ctx["attrs"].update(tilt_angle_rad=angle, tilt_fraction=frac, tilted_blocks=len(names))
 
 
 @loading("gravity")

@@ -43,6 +43,7 @@ import xarray as xr
 from numpy.typing import ArrayLike, NDArray
 
 from .case import Table, loading
+from .geometry import box, mass_properties
 from .model import GROUND, Damping, ModelBuilder, Motion
 from .records import STANDARD_GRAVITY, GroundMotion, read_record, shared_record_path
 from .simulate import Monitor, simulate
@@ -361,8 +362,6 @@ def apply_rod_pushover(
             with a critically damping dashpot beta = 2 / omega, omega = sqrt(kn rod_size span / m).
         name: rod block name.
     """
-    from .geometry import box, mass_properties
-
     if not (isinstance(displacement, (int, float)) and math.isfinite(displacement) and displacement > 0):
         raise ValueError(f"pushover displacement must be a positive distance [m], got {displacement!r}")
     if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
@@ -407,7 +406,7 @@ def apply_rod_pushover(
         builder.set_material("pushover_rod", g, material)
     # smooth start and stop (half-cosine speed ramps over 20 % of the push time each, no impact
     # on the face); the ramps lose and gain the same distance, so displacement = velocity * push_time
-    push_time = displacement / velocity
+    push_time = float(displacement) / float(velocity)
     tt = np.linspace(0.0, 0.2 * push_time, 41)
     up_ = 0.5 * (1.0 - np.cos(np.pi * tt / tt[-1]))
     times = np.r_[tt, push_time + tt]
@@ -584,7 +583,6 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
         window=window,  # type: ignore[arg-type]
         delay=t.number("delay", 0.0, min_=0.0),
     )
-    ctx["earthquake"] = info
     ctx["attrs"].update(
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,
@@ -614,7 +612,6 @@ def _pushover(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict
             max_load_factor=t.number("max_load_factor", positive=True),
             direction=direction,
         )
-        ctx["pushover"] = ramp
         ctx["attrs"].update(ramp.attrs())
         return
     disp = t.number("displacement", positive=True)
@@ -627,5 +624,4 @@ def _pushover(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict
         rod_size=t.number("rod_size", 0.02, positive=True),
     )
     monitors["rod"] = (rod.rod, tuple(b.block(rod.rod).vertices.mean(axis=0)))
-    ctx["pushover"] = rod
     ctx["attrs"].update(rod.attrs())
