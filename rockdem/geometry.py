@@ -19,6 +19,8 @@ __all__ = [
     "box",
     "mass_properties",
     "face_points",
+    "FaceGrid",
+    "face_grid",
 ]
 
 _REL_TOL = 1e-9
@@ -249,10 +251,34 @@ def _min_area_rect_axes(p2: NDArray[np.float64]) -> NDArray[np.float64]:
     return best_axis
 
 
-def face_points(
-    poly: Polyhedron, face: int, n_across: int, n_along: int
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Interface integration points of one face and their tributary areas.
+@dataclass(frozen=True)
+class FaceGrid:
+    """Interface points of one face with their tributary cells, in the face's own 2D frame.
+
+    A point x of the face plane has face coordinates (x - origin) . u, (x - origin) . w.
+
+    Attributes:
+        origin: (3,) a point of the face (its vertex centroid) [m].
+        u: (3,) unit in-plane axis "across" (the shorter side of the minimum bounding rectangle).
+        w: (3,) unit in-plane axis "along" (w = normal x u).
+        points: (k, 3) interface points [m].
+        nodes: (k, 2) the points in face coordinates [m].
+        areas: (k,) tributary areas [m^2] (they sum to the face area).
+        cells: per point, the tributary cell (its grid rectangle clipped to the face polygon) as a
+            (c, 2) counter-clockwise polygon in face coordinates [m].
+    """
+
+    origin: NDArray[np.float64]
+    u: NDArray[np.float64]
+    w: NDArray[np.float64]
+    points: NDArray[np.float64]
+    nodes: NDArray[np.float64]
+    areas: NDArray[np.float64]
+    cells: tuple[NDArray[np.float64], ...]
+
+
+def face_grid(poly: Polyhedron, face: int, n_across: int, n_along: int) -> FaceGrid:
+    """Interface integration points of one face, their tributary cells and areas.
 
     The face's minimum-area bounding rectangle defines two axes: "across" (the shorter side, the
     wall thickness for a bed face) and "along" (the longer side). ``n_across x n_along`` nodes are
@@ -260,10 +286,9 @@ def face_points(
     corners of a rectangular face (3DEC's minimal sub-contacts, the paper's "2 contact points").
     Each node's tributary cell (half cells at the ends, the trapezoidal rule) is clipped to the
     face polygon; its clipped area is the point's area, so the areas sum exactly to the face area.
-    A node outside a non-rectangular face is moved to its clipped cell's centroid.
-
-    Returns:
-        points (k, 3) [m] and areas (k,) [m^2].
+    A node outside a non-rectangular face is moved to its clipped cell's centroid. The cells are
+    what the contact law clips against a partner face (see ``docs/contacts.md``): the force of a
+    point is carried by the part of its cell that the partner covers.
     """
     if n_across < 1 or n_along < 1:
         raise ValueError(f"interface points: need at least 1 point across and along, got {n_across} x {n_along}")
@@ -276,32 +301,48 @@ def face_points(
     ay = np.cross(n, ax)
     p2 = np.column_stack(((v - c) @ ax, (v - c) @ ay))
     u = _min_area_rect_axes(p2)
-    w = np.array([-u[1], u[0]])
-    su, sw = p2 @ u, p2 @ w
-    if np.ptp(su) > np.ptp(sw):  # make u the short side ("across")
-        u, w = w, -u
-        su, sw = p2 @ u, p2 @ w
-    pts, areas = [], []
+    if np.ptp(p2 @ u) > np.ptp(p2 @ np.array([-u[1], u[0]])):  # make u the short side ("across")
+        u = np.array([-u[1], u[0]])
+    u3 = u[0] * ax + u[1] * ay
+    w3 = np.cross(n, u3)
+    q2 = np.column_stack(((v - c) @ u3, (v - c) @ w3))  # face polygon in (u, w), counter-clockwise
+    su, sw = q2[:, 0], q2[:, 1]
+    nodes, areas, cells = [], [], []
     gu = _nodes(su.min(), su.max(), n_across)
     gw = _nodes(sw.min(), sw.max(), n_along)
     size = max(np.ptp(su), np.ptp(sw))
     for (ucen, ulo, uhi) in gu:
         for (wcen, wlo, whi) in gw:
-            cell = np.array(
-                [ulo * u + wlo * w, uhi * u + wlo * w, uhi * u + whi * w, ulo * u + whi * w]
-            )
-            clipped = _clip(cell, p2)
+            cell = np.array([[ulo, wlo], [uhi, wlo], [uhi, whi], [ulo, whi]])
+            clipped = _clip(cell, q2)
             if len(clipped) < 3:
                 continue
             area = abs(_polygon_area(clipped))
             if area <= _REL_TOL * size * size:
                 continue
-            node = ucen * u + wcen * w
-            if not _inside_2d(node, p2, 1e-9 * size):
+            node = np.array([ucen, wcen])
+            if not _inside_2d(node, q2, 1e-9 * size):
                 node = _polygon_centroid(clipped)
-            pts.append(c + node[0] * ax + node[1] * ay)
+            nodes.append(node)
             areas.append(area)
-    return np.array(pts), np.array(areas)
+            cells.append(_drop_duplicates(clipped, 1e-12 * size))
+    nodes_a = np.array(nodes)
+    points = c + nodes_a[:, :1] * u3 + nodes_a[:, 1:] * w3
+    return FaceGrid(c, u3, w3, points, nodes_a, np.array(areas), tuple(cells))
+
+
+def face_points(
+    poly: Polyhedron, face: int, n_across: int, n_along: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Interface points (k, 3) [m] of one face and their tributary areas (k,) [m^2] (see :func:`face_grid`)."""
+    g = face_grid(poly, face, n_across, n_along)
+    return g.points, g.areas
+
+
+def _drop_duplicates(p: NDArray[np.float64], tol: float) -> NDArray[np.float64]:
+    """Remove consecutive (cyclically) coincident vertices of a polygon."""
+    keep = [i for i in range(len(p)) if np.max(np.abs(p[i] - p[i - 1])) > tol]
+    return p[keep] if len(keep) >= 3 else p
 
 
 def _nodes(lo: float, hi: float, k: int) -> list[tuple[float, float, float]]:

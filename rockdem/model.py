@@ -14,7 +14,8 @@ from typing import Callable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .geometry import Polyhedron, box, face_points, mass_properties
+from .flatten import BlockFrame, flatten_geometry
+from .geometry import Polyhedron, box, mass_properties
 from .kernels.layout import ModelArrays
 from .kernels.rotation import axis_angle_matrix, matrix_to_quat
 from .materials import JointMaterial
@@ -451,10 +452,10 @@ class ModelBuilder:
         vel0 = np.zeros((nb, 3))
         om0 = np.zeros((nb, 3))
         radius = np.zeros(nb)
-        vstart, fstart, estart, pstart = [0], [0], [0], [0]
-        vloc, fnorm, foff, farea, enorm, eoff, ploc, parea, pblock = [], [], [], [], [], [], [], [], []
+        frames: list[BlockFrame] = []
         faces_out = []
         min_dim = np.inf
+        vcount = 0
         for b, blk in enumerate(self._blocks):
             mp = mass_properties(blk.poly, blk.density)
             if not mp.volume > 0:
@@ -472,32 +473,12 @@ class ModelBuilder:
             om0[b] = rot.T @ blk.angular_velocity if free else 0.0
             local = (blk.poly.vertices - mp.centroid) @ rot
             radius[b] = float(np.max(np.linalg.norm(local, axis=1)))
-            if blk.driven is False:
+            if free:
                 min_dim = min(min_dim, float(np.ptp(local, axis=0).min()))
-            base_v = vstart[-1]
-            vloc.append(local)
-            vstart.append(base_v + len(local))
-            faces_out.append(tuple(f + base_v for f in blk.poly.faces))
-            nrm_local = blk.poly.normals @ rot
-            for k, fverts in enumerate(blk.poly.faces):
-                n = nrm_local[k]
-                fv = local[fverts]
-                fnorm.append(n)
-                foff.append(float(n @ fv[0]))
-                pts, areas = face_points(blk.poly, k, *blk.points)
-                farea.append(float(areas.sum()))
-                for j in range(len(fv)):
-                    e = fv[(j + 1) % len(fv)] - fv[j]
-                    m_ = np.cross(e, n)
-                    m_ /= np.linalg.norm(m_)
-                    enorm.append(m_)
-                    eoff.append(float(m_ @ fv[j]))
-                estart.append(estart[-1] + len(fv))
-                ploc.append((pts - mp.centroid) @ rot)
-                parea.append(areas)
-                pblock.append(np.full(len(areas), b))
-                pstart.append(pstart[-1] + len(areas))
-            fstart.append(fstart[-1] + len(blk.poly.faces))
+            faces_out.append(tuple(f + vcount for f in blk.poly.faces))
+            vcount += len(local)
+            frames.append(BlockFrame(blk.poly, mp.centroid, rot, blk.points))
+        geometry = flatten_geometry(frames)
 
         free_mask = np.array([blk.driven is False for blk in self._blocks])
         if contact_tolerance is None:
@@ -526,19 +507,7 @@ class ModelBuilder:
             block_motion=np.array(block_motion, dtype=np.int64),
             block_group=np.array([gi[blk.group] for blk in self._blocks], dtype=np.int64),
             block_radius=radius,
-            block_vertex_start=np.array(vstart, dtype=np.int64),
-            vertex_local=np.concatenate(vloc),
-            block_face_start=np.array(fstart, dtype=np.int64),
-            face_normal=np.array(fnorm),
-            face_offset=np.array(foff),
-            face_area=np.array(farea),
-            face_edge_start=np.array(estart, dtype=np.int64),
-            edge_normal=np.array(enorm),
-            edge_offset=np.array(eoff),
-            face_point_start=np.array(pstart, dtype=np.int64),
-            point_local=np.concatenate(ploc),
-            point_area=np.concatenate(parea),
-            point_block=np.concatenate(pblock).astype(np.int64),
+            **geometry,
             mat_kn=tables["kn"],
             mat_ks=tables["ks"],
             mat_cohesion=tables["c"],
@@ -559,7 +528,8 @@ class ModelBuilder:
             body_time=bt,
             body_acceleration=ba,
             contact_tol=float(contact_tolerance),
-            edge_tol=0.1 * float(contact_tolerance),
+            touch_tol=0.1 * float(contact_tolerance),
+            **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0),
         )
         return Model(
             arrays=arrays,
@@ -586,6 +556,19 @@ class ModelBuilder:
         if not 0 <= i < len(self._blocks):
             raise IndexError(f"block id {i} out of range (0..{len(self._blocks) - 1})")
         return i
+
+
+def _extent(vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+    """The model's extent: the bounding box of every block at the start, enlarged on each side by
+    its largest dimension (at least 1 m). A free block whose centroid leaves it has fallen through
+    its support or flown away, and the run stops there."""
+    from .kernels.rotation import quats_to_matrices
+
+    r = quats_to_matrices(quat)
+    world = np.vstack([vertex_local[vstart[b] : vstart[b + 1]] @ r[b].T + pos[b] for b in range(len(pos))])
+    lo, hi = world.min(axis=0), world.max(axis=0)
+    margin = max(float(np.max(hi - lo)), 1.0)
+    return {"extent_low": lo - margin, "extent_high": hi + margin}
 
 
 def _check_points(points: Sequence[int], what: str) -> tuple[int, int]:

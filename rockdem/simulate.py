@@ -1,34 +1,42 @@
 """``simulate()``: the one entry point that owns the time loop, the recording and the progress.
 
 The loop runs in compiled chunks (:func:`rockdem.kernels.step.advance`); Python only sees chunk
-boundaries, where it updates the progress bar. An interrupted run (Ctrl-C) returns the frames
-computed so far, flagged ``interrupted``.
+boundaries, where it updates the progress bar and enlarges the contact buffers when a detection
+asks for it. A run that goes wrong stops at the first bad recorded frame: when its energy balance
+breaks or its state is no longer finite (diverged), or when a free block leaves the model's extent
+(it fell through its support or flew away); the result keeps the frames before it and says where
+(``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
+``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
+``interrupted``.
 """
 
 from __future__ import annotations
 
 import math
-import warnings
 import time as _time
-from typing import Mapping, Sequence
+import warnings
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 
-from .kernels.layout import Records, new_records
-from .kernels.step import advance
+from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, new_records
+from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
 from .results import build_dataset
 from .snapshots import ContactSnapshots
-from .state import initial_state
-from .timestep import TimestepInfo, stable_timestep
+from .state import grow_buffers, initial_state
+from .timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, TimestepInfo, stable_timestep
 
-__all__ = ["simulate", "Monitor"]
+__all__ = ["simulate", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
 
 Monitor = tuple[int | str, Sequence[float]]
 """A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
 
 _MAX_RECORD_BYTES = 2 * 1024**3
+
+DEFAULT_MAX_STEPS = 1_000_000_000
+"""Largest number of steps a run may need before it is refused (raise it with ``max_steps``)."""
 
 
 def simulate(
@@ -37,20 +45,24 @@ def simulate(
     *,
     dt: float | None = None,
     timestep_rule: str = "bound",
-    safety: float = 0.9,
+    safety: float = DEFAULT_SAFETY,
+    resolution: float = DEFAULT_RESOLUTION,
     record_interval: float = 0.002,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
     contact_interval: float | None = None,
+    max_steps: int = DEFAULT_MAX_STEPS,
 ) -> xr.Dataset:
     """Run ``model`` for ``duration`` seconds and return the recorded histories.
 
     Args:
-        model: a finalized model.
+        model: a finalized model (:meth:`rockdem.model.ModelBuilder.finalize`).
         duration: simulated time [s].
         dt: timestep [s]; default automatic (see :mod:`rockdem.timestep`); refused above the bound.
         timestep_rule: "bound" (default) or "3dec" (0.2 sqrt(m_min/k_max)).
         safety: fraction of the stable bound for the automatic timestep.
+        resolution: largest omega_max dt / 2, so that impacts last several steps and keep their
+            energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
         record_interval: time between recorded frames [s] (rounded to whole steps).
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
@@ -58,17 +70,27 @@ def simulate(
         progress: show a progress bar; default: only for runs expected to last over 2 s.
         contact_interval: time between sub-contact snapshots [s] (see :mod:`rockdem.snapshots`);
             default None: none recorded.
+        max_steps: a run estimated to need more steps (duration / initial dt) is refused before it
+            starts, with the estimate: an absurd stiffness, mass or damping would otherwise hang.
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
+
+    Raises:
+        TypeError: ``model`` is not a finalized Model.
+        ValueError: bad options, a timestep longer than the run, or more steps than ``max_steps``.
     """
-    if not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration must be a positive time [s], got {duration!r}")
-    if not (math.isfinite(record_interval) and record_interval > 0):
-        raise ValueError(f"record_interval must be a positive time [s], got {record_interval!r}")
+    if not isinstance(model, Model):
+        hint = " (call builder.finalize() first)" if type(model).__name__ == "ModelBuilder" else ""
+        raise TypeError(f"simulate: model must be a rockdem Model{hint}, got {type(model).__name__}")
+    duration = _positive_number("duration", duration, "s")
+    record_interval = _positive_number("record_interval", record_interval, "s")
+    if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
+        raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
     mon = _check_monitors(model, monitors or {})
     snaps = ContactSnapshots(model, contact_interval)
-    info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, dt=dt)
+    info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    _check_step_count(info, duration, max_steps)
     frames = int(math.floor(duration / record_interval + 1e-9)) + 1
     need = frames * model.block_count * 13 * 8
     if need > _MAX_RECORD_BYTES:
@@ -78,77 +100,138 @@ def simulate(
         )
     wall0 = _time.perf_counter()
     state, scratch = initial_state(model)
-    state.clock[1] = state.clock[2] = state.clock[4] = info.dt
-    state.clock[3] = safety
-    snaps.take(state)
-    rec = new_records(frames, model.block_count, int(np.count_nonzero(~model.arrays.block_free.astype(bool))))
+    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
+    state.safety[0] = safety
+    state.resolution[0] = resolution if info.rule == "bound" else 1.0
     m = model.arrays
+    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
+    snaps.take(state)
+    rec = new_records(frames, model.block_count, int(np.count_nonzero(~m.block_free.astype(bool))))
     frame = 0
+    status = STATUS_DONE
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
     bar = None
     interrupted = False
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
-        while state.clock[0] < t_end and frame < frames:
-            t_before = float(state.clock[0])
-            stop = snaps.clip(min(t_end, t_before + chunk))
+        while state.time[0] < t_end and frame < frames:
+            stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
             t0 = _time.perf_counter()
-            frame = advance(m, state, scratch, stop, record_interval, rec, frame)
+            frame, status = advance(m, state, scratch, stop, record_interval, rec, frame)
             elapsed = _time.perf_counter() - t0
+            if status == STATUS_GROW:
+                state, scratch = grow_buffers(state, scratch)
+                continue
+            if status != STATUS_DONE:
+                break
             snaps.take(state)
-            chunk = min(chunk * 4.0, max(state.clock[1], chunk * 0.25 / max(elapsed, 1e-6)))
+            chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
-                from tqdm.auto import tqdm
-
-                bar = tqdm(total=round(duration, 6), unit="s", desc="rockdem", initial=round(float(state.clock[0]), 6))
-            elif bar is not None:
-                bar.update(round(float(state.clock[0]) - t_before, 6))
+                bar = _progress_bar(duration)
+            if bar is not None:
+                bar.update(min(float(state.time[0]), duration) - bar.n)
     except KeyboardInterrupt:
         interrupted = True
     finally:
         if bar is not None:
             bar.close()
     runtime = _time.perf_counter() - wall0
-    rec = Records(*(a[:frame] for a in rec))
-    attrs = {
-            "dt": info.dt,
-            "dt_min": float(state.clock[4]),
-            "dt_critical": info.critical,
-            "omega_max": info.omega_max,
-            "sp_factor": info.sp_factor,
-            "timestep_rule": info.rule,
-            "steps": int(state.step[0]),
-            "runtime_s": runtime,
-            "duration": duration,
-            "record_interval": record_interval,
-            "interrupted": int(interrupted),
+    attrs: dict[str, Any] = {
+        "dt": info.dt,
+        "dt_min": float(state.dt_min[0]),
+        "dt_critical": info.critical,
+        "omega_max": info.omega_max,
+        "sp_factor": info.sp_factor,
+        "resolution": info.resolution,
+        "timestep_rule": info.rule,
+        "steps": int(state.step[0]),
+        "runtime_s": runtime,
+        "duration": duration,
+        "record_interval": record_interval,
+        "interrupted": int(interrupted),
     }
+    if status in (STATUS_DIVERGED, STATUS_LOST):
+        attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
+        warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
+        frame -= 1  # keep the sound frames before the bad one
+    rec = Records(*(a[:frame] for a in rec))
     ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
-    bad = first_diverged_frame(ds)
-    if bad is not None:
-        t_bad = float(rec.time[bad])
-        warnings.warn(
-            f"the simulation diverged at t = {t_bad:.4g} s (energy balance broken or non-finite state); "
-            "the result holds the frames before it (attrs diverged = 1). Check the contact tolerance, "
-            "the timestep safety and the joint strengths.",
-            RuntimeWarning,
-            stacklevel=2,
-        )
-        rec = Records(*(a[:bad] for a in rec))
-        ds = build_dataset(model, rec, monitors=mon, attrs={**attrs, "diverged": 1, "diverged_time": t_bad})
     return snaps.attach(ds)
 
 
-DIVERGENCE_ERROR = 0.2
-"""Energy-balance error, as a fraction of the run's energy scale so far, that marks a divergence."""
+def _positive_number(name: str, value: Any, unit: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise TypeError(f"{name} must be a number [{unit}], got {type(value).__name__} {value!r}")
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a positive time [{unit}], got {value!r}")
+    return float(value)
+
+
+def _check_step_count(info: TimestepInfo, duration: float, max_steps: int) -> None:
+    """Refuse runs whose timestep exceeds the run or whose step count exceeds ``max_steps``."""
+    where = (
+        f"(omega_max = {info.omega_max:.4g} rad/s, SP reduction {info.sp_factor:.3g}); check the units "
+        "(stiffness kn in Pa/m or E in Pa, density in kg/m^3, beta in s)"
+    )
+    if not (math.isfinite(info.dt) and info.dt > 0):
+        raise ValueError(f"the stable timestep of this model is {info.dt!r} s: the run cannot proceed {where}")
+    if info.dt > duration:
+        raise ValueError(
+            f"the timestep {info.dt:.3g} s is longer than the run ({duration:.3g} s): the contacts are implausibly "
+            f"soft or the blocks implausibly heavy {where}"
+        )
+    steps = duration / info.dt
+    if steps > max_steps:
+        raise ValueError(
+            f"the run needs about {steps:.3g} steps of {info.dt:.3g} s (limit max_steps = {max_steps:.3g}): "
+            f"the contacts are implausibly stiff or the damping implausibly high {where}; raise max_steps "
+            "if this is intended"
+        )
+
+
+def _failure(model: Model, rec: Records, bad: int, status: int, block: int, step: int) -> dict[str, Any]:
+    """Attributes describing where a run went wrong (the bad frame ``bad``)."""
+    t_bad = float(rec.time[bad])
+    if block >= 0:
+        blocks = [model.block_names[block]]
+    else:  # the blocks moving fastest at the bad frame
+        ke = 0.5 * model.arrays.block_mass * np.sum(np.nan_to_num(rec.velocity[bad], nan=np.inf) ** 2, axis=1)
+        ke[~model.arrays.block_free] = -1.0
+        blocks = [model.block_names[b] for b in np.argsort(-ke)[: min(3, int(model.arrays.block_free.sum()))]]
+    if status == STATUS_LOST:
+        reason = "left the model's extent (fell through its support or flew away: check the joint stiffness and the foundation size)"
+    else:
+        reason = (
+            f"energy balance broken by more than {DIVERGENCE_ERROR:.0%} of the energy scale, or a non-finite state "
+            "(check the timestep safety, the joint stiffness and strengths)"
+        )
+    msg = f"the run stopped at t = {t_bad:.4g} s (step {step}): block(s) {', '.join(blocks)} {reason}; the result holds the frames before it"
+    return {
+        "diverged": 1,
+        "diverged_time": t_bad,
+        "diverged_step": step,
+        "diverged_blocks": ", ".join(blocks),
+        "diverged_reason": "lost" if status == STATUS_LOST else "energy",
+        "diverged_message": msg,
+    }
+
+
+def _progress_bar(duration: float) -> Any:
+    from tqdm.auto import tqdm
+
+    return tqdm(
+        total=duration,
+        unit="s",
+        desc="rockdem",
+        bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3f}/{total:.3f} s simulated [{elapsed}<{remaining}]",
+    )
 
 
 def first_diverged_frame(ds: xr.Dataset) -> int | None:
-    """Index of the first frame with a non-finite state or an energy-balance error above
-    :data:`DIVERGENCE_ERROR` of the energy scale reached so far (kinetic + elastic + |potential| +
-    dissipated + |work|, at least the work of lifting the free blocks by 1 mm); None if the run stayed
-    sound. A converged explicit run keeps the error
-    near 1e-3; a numerical blow-up (e.g. a contact cascade) breaks it before the state overflows."""
+    """Index of the first frame of a result with a non-finite state or an energy-balance error
+    above :data:`DIVERGENCE_ERROR` of the energy scale reached so far (kinetic + elastic +
+    |potential| + dissipated + |work|, at least the work of lifting the free blocks by 1 mm); None
+    if the run stayed sound. The engine applies the same test while it runs and stops there."""
     err = np.abs(ds.energy_balance_error.values)
     parts = [np.abs(ds[n].values) for n in ds.data_vars if n.startswith(("energy_", "work_")) and "balance" not in n]
     floor = 9.81e-3 * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum())  # 1 mm of lift

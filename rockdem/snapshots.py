@@ -6,8 +6,9 @@ result over the dims (``contact_time``, ``point``):
 
   contact_time (contact_time) [s]              engine clock at the snapshot
   point_position (contact_time, point, xyz) [m] world position of the point (every point)
-  point_partner (contact_time, point) int32     partner block id, -1 where none
-  point_normal_force (contact_time, point) [N]  elastic normal force (compression > 0), NaN where no partner
+  point_partner (contact_time, point) int32     partner block id (of the more loaded slot), -1 where none
+  point_normal_force (contact_time, point) [N]  elastic normal force, summed over the point's partners
+                                                (compression > 0), NaN where no partner
   point_shear_force (contact_time, point) [N]   magnitude of the elastic shear force, NaN where no partner
   point_bonded (contact_time, point) int8       1 bonded, 0 not, -1 where no partner
   point_failed (contact_time, point) int8       0 intact, 1 failed in tension, 2 failed in shear
@@ -60,18 +61,24 @@ class ContactSnapshots:
         """Snapshot the points if the clock has reached the next snapshot time."""
         if self.interval is None:
             return
-        t = float(state.clock[0])
+        t = float(state.time[0])
         due = self.count * self.interval
         if t < due - 1e-12 * max(1.0, due):
             return
         m = self.model.arrays
         rot = quats_to_matrices(state.quaternion)[m.point_block]  # (np, 3, 3)
         pos = np.einsum("pij,pj->pi", rot, m.point_local) + state.position[m.point_block]
-        partner = state.point_partner.astype(np.int32)
+        # A point may press on two partners (slots); report the slot carrying the larger force.
+        slots = state.slot_partner
+        k = np.argmax(np.where(slots >= 0, np.abs(state.slot_normal_force) + 1e-300, -1.0), axis=1)
+        rows = np.arange(len(k))
+        partner = slots[rows, k].astype(np.int32)
         has = partner >= 0
-        normal = np.where(has, state.point_normal_force, np.nan)
-        shear = np.where(has, np.linalg.norm(state.point_shear, axis=1), np.nan)
-        bonded = np.where(has, state.point_bonded.astype(np.int8), np.int8(-1)).astype(np.int8)
+        normal = np.where(has, state.slot_normal_force.sum(axis=1), np.nan)
+        ks = m.mat_ks[m.block_group[m.point_block][:, None], m.block_group[np.maximum(slots, 0)]]
+        shear_force = (ks * state.slot_area)[..., None] * state.slot_shear  # (np, slots, 3) [N]
+        shear = np.where(has, np.linalg.norm(shear_force.sum(axis=1), axis=1), np.nan)
+        bonded = np.where(has, state.slot_bonded.any(axis=1).astype(np.int8), np.int8(-1)).astype(np.int8)
         failed = state.point_failed.astype(np.int8)
         self.rows.append((t, pos, partner, normal, shear, bonded, failed))
         # Skip snapshot times already passed (a chunk may overshoot by one step).

@@ -4,11 +4,155 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels.detect import detect, point_in_target, update_rotations
-from .kernels.layout import ENERGY_COUNT, FAILED_NONE, Scratch, State
+from .kernels.detect import detect, update_rotations
+from .kernels.faces import cover, face_map
+from .kernels.layout import ENERGY_COUNT, FAILED_NONE, SLOTS, Scratch, State
 from .model import Model
 
-__all__ = ["initial_state"]
+__all__ = ["initial_state", "grow_buffers"]
+
+
+def _pair_arrays(count: int) -> dict[str, np.ndarray]:
+    i64 = np.int64
+    return {
+        "pair_a": np.zeros(count, dtype=i64),
+        "pair_b": np.zeros(count, dtype=i64),
+        "pair_kind": np.zeros(count, dtype=i64),
+        "pair_owner_face": np.zeros(count, dtype=i64),
+        "pair_target_face": np.zeros(count, dtype=i64),
+        "pair_track_start": np.zeros(count, dtype=i64),
+        "pair_track_stop": np.zeros(count, dtype=i64),
+        "pair_edge_a": np.zeros(count, dtype=i64),
+        "pair_edge_b": np.zeros(count, dtype=i64),
+        "pair_normal": np.zeros((count, 3)),
+        "pair_shear": np.zeros((count, 3)),
+        "pair_normal_force": np.zeros(count),
+        "pair_overlap": np.zeros(count),
+    }
+
+
+def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
+    i64 = np.int64
+    return {
+        "pair_dashpot_force": np.zeros((count, 3)),
+        "pair_dashpot_point": np.zeros((count, 3)),
+        "prev_pair_a": np.zeros(count, dtype=i64),
+        "prev_pair_b": np.zeros(count, dtype=i64),
+        "prev_pair_kind": np.zeros(count, dtype=i64),
+        "prev_pair_owner_face": np.zeros(count, dtype=i64),
+        "prev_pair_target_face": np.zeros(count, dtype=i64),
+        "prev_pair_edge_a": np.zeros(count, dtype=i64),
+        "prev_pair_edge_b": np.zeros(count, dtype=i64),
+        "prev_pair_shear": np.zeros((count, 3)),
+        "prev_pair_normal": np.zeros((count, 3)),
+        "prev_pair_normal_force": np.zeros(count),
+        "prev_pair_overlap": np.zeros(count),
+        "prev_pair_key": np.zeros(count, dtype=i64),
+        "prev_pair_index": np.zeros(count, dtype=i64),
+        "prev_pair_kept": np.zeros(count, dtype=np.bool_),
+    }
+
+
+def _scratch_candidates(count: int) -> dict[str, np.ndarray]:
+    i64 = np.int64
+    return {
+        "cand_code": np.zeros(count, dtype=i64),
+        "cand_partner": np.zeros(count, dtype=i64),
+        "cand_face": np.zeros(count, dtype=i64),
+        "cand_slot": np.zeros(count, dtype=i64),
+    }
+
+
+def _allocate(model: Model) -> tuple[State, Scratch]:
+    m = model.arrays
+    nb, n_pts, nv = model.block_count, model.point_count, m.vertex_local.shape[0]
+    pairs = max(64, 16 * nb)
+    cands = SLOTS * n_pts + 64
+    one = np.zeros(1)
+    s = State(
+        time=one.copy(),
+        dt=one.copy(),
+        dt_prev=one.copy(),
+        dt_min=one.copy(),
+        safety=one.copy(),
+        resolution=one.copy(),
+        step=np.zeros(1, dtype=np.int64),
+        position=model.position0.copy(),
+        quaternion=model.quaternion0.copy(),
+        velocity=model.velocity0.copy(),
+        omega=model.omega0.copy(),
+        slot_partner=np.full((n_pts, SLOTS), -1, dtype=np.int64),
+        slot_face=np.full((n_pts, SLOTS), -1, dtype=np.int64),
+        slot_shear=np.zeros((n_pts, SLOTS, 3)),
+        slot_normal_force=np.zeros((n_pts, SLOTS)),
+        slot_area=np.zeros((n_pts, SLOTS)),
+        slot_overlap=np.zeros((n_pts, SLOTS)),
+        slot_bonded=np.zeros((n_pts, SLOTS), dtype=np.bool_),
+        point_failed=np.full(n_pts, FAILED_NONE, dtype=np.int64),
+        energy=np.zeros(ENERGY_COUNT),
+        track=np.zeros(SLOTS * n_pts, dtype=np.int64),
+        track_count=np.zeros(1, dtype=np.int64),
+        pair_count=np.zeros(1, dtype=np.int64),
+        moved=np.zeros(nb),
+        **_pair_arrays(pairs),
+    )
+    sc = Scratch(
+        rotation=np.zeros((nb, 3, 3)),
+        force=np.zeros((nb, 3)),
+        torque=np.zeros((nb, 3)),
+        world_vertex=np.zeros((nv, 3)),
+        aabb=np.zeros((nb, 6)),
+        seen=np.zeros(SLOTS * n_pts, dtype=np.int64),
+        passes=np.zeros(1, dtype=np.int64),
+        elastic_energy=one.copy(),
+        active_count=np.zeros(1, dtype=np.int64),
+        reaction=np.zeros(3),
+        min_separation=one.copy(),
+        min_pair=np.full(2, -1, dtype=np.int64),
+        overflow=np.zeros(1, dtype=np.int64),
+        ground_velocity=np.zeros(3),
+        body_acc=np.zeros(3),
+        driven_velocity=np.zeros(3),
+        omega_world=np.zeros((nb, 3)),
+        dashpot_force=np.zeros((SLOTS * n_pts, 3)),
+        dashpot_point=np.zeros((SLOTS * n_pts, 3)),
+        velocity_mid=np.zeros((nb, 3)),
+        omega_mid=np.zeros((nb, 3)),
+        poly_a=np.zeros((32, 2)),
+        poly_b=np.zeros((32, 2)),
+        prev_pair_count=np.zeros(1, dtype=np.int64),
+        energy_scale=one.copy(),
+        lost_block=np.full(1, -1, dtype=np.int64),
+        **_scratch_pairs(pairs),
+        **_scratch_candidates(cands),
+    )
+    return s, sc
+
+
+def grow_buffers(s: State, sc: Scratch) -> tuple[State, Scratch]:
+    """Double the pair and candidate buffers (after a detection reported an overflow)."""
+    pairs = 2 * s.pair_a.shape[0]
+    cands = 2 * sc.cand_code.shape[0]
+    new_pairs = _pair_arrays(pairs)
+    for name, arr in new_pairs.items():
+        old = getattr(s, name)
+        arr[: old.shape[0]] = old
+    new_scr = _scratch_pairs(pairs)
+    for name, arr in new_scr.items():
+        old = getattr(sc, name)
+        arr[: old.shape[0]] = old
+    return s._replace(**new_pairs), sc._replace(**new_scr, **_scratch_candidates(cands))
+
+
+def detect_all(model: Model, s: State, sc: Scratch) -> tuple[State, Scratch]:
+    """Contact detection at the current state, enlarging the buffers until everything fits."""
+    m = model.arrays
+    update_rotations(m, s, sc)
+    while True:
+        detect(m, s, sc)
+        if sc.overflow[0] == 0:
+            return s, sc
+        s, sc = grow_buffers(s, sc)
 
 
 def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, Scratch]:
@@ -18,58 +162,28 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
         ValueError: two blocks overlap at the start (names both and the depth).
     """
     m = model.arrays
-    nb, n_pts, nv = model.block_count, model.point_count, m.vertex_local.shape[0]
-    s = State(
-        clock=np.zeros(6),
-        step=np.zeros(1, dtype=np.int64),
-        position=model.position0.copy(),
-        quaternion=model.quaternion0.copy(),
-        velocity=model.velocity0.copy(),
-        omega=model.omega0.copy(),
-        point_partner=np.full(n_pts, -1, dtype=np.int64),
-        point_target_face=np.full(n_pts, -1, dtype=np.int64),
-        point_shear=np.zeros((n_pts, 3)),
-        point_normal_force=np.zeros(n_pts),
-        point_bonded=np.zeros(n_pts, dtype=np.bool_),
-        point_failed=np.full(n_pts, FAILED_NONE, dtype=np.int64),
-        energy=np.zeros(ENERGY_COUNT),
-        track=np.zeros(n_pts, dtype=np.int64),
-        track_count=np.zeros(1, dtype=np.int64),
-        moved=np.zeros(nb),
-    )
-    sc = Scratch(
-        rotation=np.zeros((nb, 3, 3)),
-        force=np.zeros((nb, 3)),
-        torque=np.zeros((nb, 3)),
-        world_vertex=np.zeros((nv, 3)),
-        aabb=np.zeros((nb, 6)),
-        seen=np.zeros(n_pts, dtype=np.int64),
-        prev_partner=np.full(n_pts, -1, dtype=np.int64),
-        passes=np.zeros(1, dtype=np.int64),
-        sums=np.zeros(8),
-        ground_velocity=np.zeros(3),
-        body_acc=np.zeros(3),
-        omega_world=np.zeros((nb, 3)),
-        point_tmp=np.zeros(4),
-        dashpot_force=np.zeros((n_pts, 3)),
-        dashpot_point=np.zeros((n_pts, 3)),
-        velocity_mid=np.zeros((nb, 3)),
-        omega_mid=np.zeros((nb, 3)),
-    )
-    update_rotations(m, s, sc)
-    detect(m, s, sc)
-    depth = -sc.sums[5]
-    if check_overlap and depth > m.edge_tol:
-        a, b = int(sc.sums[6]), int(sc.sums[7])
+    s, sc = _allocate(model)
+    s, sc = detect_all(model, s, sc)
+    depth = -float(sc.min_separation[0])
+    if check_overlap and depth > m.touch_tol:
+        a, b = (int(v) for v in sc.min_pair)
         raise ValueError(
             f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.4g} m at the "
-            f"start (tolerance {m.edge_tol:.3g} m); move them apart so that they at most touch"
+            f"start (tolerance {m.touch_tol:.3g} m); move them apart so that they at most touch"
         )
-    tmp = np.zeros(4)
-    for k in range(int(s.track_count[0])):
-        p = int(s.track[k])
-        t = int(s.point_partner[p])
-        gap = point_in_target(m, s, sc, p, t, int(s.point_target_face[p]), tmp)
-        touching = abs(gap) <= m.edge_tol and tmp[3] <= m.edge_tol
-        s.point_bonded[p] = touching and m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[t]]
+    for i in range(int(s.pair_count[0])):
+        if s.pair_kind[i] != 0:
+            continue
+        fo, ft = int(s.pair_owner_face[i]), int(s.pair_target_face[i])
+        fm = face_map(m, s, sc, fo, ft)
+        if abs(fm.det) < 1e-9:
+            continue
+        for k in range(int(s.pair_track_start[i]), int(s.pair_track_stop[i])):
+            p, j = divmod(int(s.track[k]), SLOTS)
+            area, yu, yw = cover(m, sc, p, ft, fm, 0.0)
+            gap = fm.h0 + fm.hu * yu + fm.hw * yw
+            touching = area > 0.0 and abs(gap) <= m.touch_tol
+            s.slot_bonded[p, j] = touching and bool(m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[int(s.slot_partner[p, j])]])
+            s.slot_area[p, j] = area
+            s.slot_overlap[p, j] = -gap
     return s, sc

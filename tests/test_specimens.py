@@ -39,17 +39,18 @@ def test_wall_counts_mass_no_overlap_and_bonded_joints(bond, count):
     state, _ = initial_state(model)  # raises on overlap
     a = model.arrays
     brick_g = model.group_names.index("brick")
-    pts = np.flatnonzero(state.point_partner >= 0)
-    owner_g, partner_g = a.block_group[a.point_block[pts]], a.block_group[state.point_partner[pts]]
+    pts, slot = np.nonzero(state.slot_partner >= 0)  # sub-contacts: (point, slot)
+    partner = state.slot_partner[pts, slot]
+    owner_g, partner_g = a.block_group[a.point_block[pts]], a.block_group[partner]
     joint = (owner_g == brick_g) & (partner_g == brick_g)
     assert joint.sum() > 0
-    assert state.point_bonded[pts[joint]].all()
-    assert not state.point_bonded[pts[~joint]].any()  # base material: no cohesion, not bonded
+    assert state.slot_bonded[pts[joint], slot[joint]].all()
+    assert not state.slot_bonded[pts[~joint], slot[~joint]].any()  # base material: no cohesion, not bonded
     # every brick above the first course carries bed-joint points
     for name in model.block_names:
         if name.startswith("brick_") and not name.startswith("brick_0_"):
             b = model.block_id(name)
-            touching = set(state.point_partner[a.point_block == b]) | set(a.point_block[pts[state.point_partner[pts] == b]])
+            touching = set(partner[a.point_block[pts] == b]) | set(a.point_block[pts[partner == b]])
             assert len(touching - {-1, b}) >= 2
 
 

@@ -1,13 +1,15 @@
-"""Stable-timestep bound from the tracked sub-contacts (DESIGN §2 "Timestep").
+"""Stable-timestep bound from the tracked contacts (DESIGN: engine, timestep).
 
-A Gershgorin-type bound of the highest circular frequency: each tracked sub-contact adds, for each
-of its three spring directions d (normal kn A, two tangents ks A), a rank-one stiffness term
+A Gershgorin-type bound of the highest circular frequency: each tracked contact adds, for each of
+its three spring directions d (normal kn A, two tangents ks A), a rank-one stiffness term
 k g g^T with g = [d; r x d] on each of its two blocks. With u_b = sqrt(k (1/m_b + sum_j (r_b x
 d)_j^2 / I_bj)) (principal body frame; 0 for a driven block), the row sum of block b is
 sum u_b (u_b + u_o), an upper bound of omega^2 over the whole system. Then, per block,
 dt_b = (2 / omega_b) (sqrt(1 + xi^2) - xi), xi = beta omega_b / 2 (Belytschko), beta the largest
-of its joints. Tracked points include every point within the tracking tolerance, so the bound
-holds until the next detection, when it is computed again.
+of its joints. A sub-contact counts with its full cell area (the most its partner can cover) at its
+point, an edge contact with its area at the middle of its edge; tracked contacts include every
+one within the tracking tolerance, so the bound holds until the next detection, when it is
+computed again.
 """
 
 from __future__ import annotations
@@ -18,10 +20,10 @@ import numpy as np
 from numba import njit
 
 from .contact import sp_critical_factor
-from .layout import ModelArrays, Scratch, State
+from .layout import PAIR_EDGE, SLOTS, ModelArrays, Scratch, State
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, r1: float, r2: float, d0: float, d1: float, d2: float) -> float:
     """1/m + sum_j (r x d)_j^2 / I_j in a block's principal frame (0 for driven blocks: inv_mass 0)."""
     if inv_mass == 0.0:
@@ -36,70 +38,90 @@ def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, 
     return out
 
 
+@njit(cache=True, inline="always")
+def _add_contact(
+    m: ModelArrays, s: State, sc: Scratch, row: np.ndarray, beta: np.ndarray, o: int, t: int,
+    x0: float, x1: float, x2: float, n0: float, n1: float, n2: float, area: float,
+) -> None:
+    """Add the three springs of a contact at world point x with normal n between blocks o and t."""
+    go, gt = m.block_group[o], m.block_group[t]
+    ro = sc.rotation[o]
+    rt = sc.rotation[t]
+    a0, a1, a2 = x0 - s.position[o, 0], x1 - s.position[o, 1], x2 - s.position[o, 2]
+    b0, b1, b2 = x0 - s.position[t, 0], x1 - s.position[t, 1], x2 - s.position[t, 2]
+    if abs(n0) < 0.9:
+        u0, u1, u2 = 0.0, n2, -n1
+    else:
+        u0, u1, u2 = -n2, 0.0, n0
+    inv = 1.0 / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    u0, u1, u2 = u0 * inv, u1 * inv, u2 * inv
+    w0, w1, w2 = n1 * u2 - n2 * u1, n2 * u0 - n0 * u2, n0 * u1 - n1 * u0
+    kn_ = m.mat_kn[go, gt] * area
+    ks_ = m.mat_ks[go, gt] * area
+    for dir_ in range(3):
+        if dir_ == 0:
+            d0, d1, d2, k_ = n0, n1, n2, kn_
+        elif dir_ == 1:
+            d0, d1, d2, k_ = u0, u1, u2, ks_
+        else:
+            d0, d1, d2, k_ = w0, w1, w2, ks_
+        uo = math.sqrt(k_ * _flex(ro, m.block_inv_mass[o], m.block_inv_inertia[o], a0, a1, a2, d0, d1, d2))
+        ut = math.sqrt(k_ * _flex(rt, m.block_inv_mass[t], m.block_inv_inertia[t], b0, b1, b2, d0, d1, d2))
+        row[o] += uo * (uo + ut)
+        row[t] += ut * (ut + uo)
+    bt = m.mat_beta[go, gt]
+    beta[o] = max(beta[o], bt)
+    beta[t] = max(beta[t], bt)
+
+
 @njit(cache=True)
-def contact_bound(m: ModelArrays, s: State, sc: Scratch, out: np.ndarray) -> None:
+def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, float]:
     """Critical timestep of the tracked contacts (safety 1).
 
-    ``out`` (3,) receives [dt_critical s, omega_max rad/s, SP factor] of the limiting block;
-    dt_critical is +inf when no block has a contact.
+    Returns (dt_critical [s], omega_max [rad/s], SP factor) of the limiting block; dt_critical is
+    +inf when no block has a contact.
     """
     nb = m.block_mass.shape[0]
     row = np.zeros(nb)
     beta = np.zeros(nb)
-    for k in range(s.track_count[0]):
-        p = s.track[k]
-        o = m.point_block[p]
-        t = s.point_partner[p]
-        tf = s.point_target_face[p]
-        go, gt = m.block_group[o], m.block_group[t]
-        area = m.point_area[p]
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            a, b = s.pair_a[i], s.pair_b[i]
+            ea, eb = s.pair_edge_a[i], s.pair_edge_b[i]
+            ra = sc.rotation[a]
+            va = m.vertex_local[m.edge_vertex[ea, 0]]
+            vb = m.vertex_local[m.edge_vertex[ea, 1]]
+            x0 = ra[0, 0] * (va[0] + vb[0]) * 0.5 + ra[0, 1] * (va[1] + vb[1]) * 0.5 + ra[0, 2] * (va[2] + vb[2]) * 0.5 + s.position[a, 0]
+            x1 = ra[1, 0] * (va[0] + vb[0]) * 0.5 + ra[1, 1] * (va[1] + vb[1]) * 0.5 + ra[1, 2] * (va[2] + vb[2]) * 0.5 + s.position[a, 1]
+            x2 = ra[2, 0] * (va[0] + vb[0]) * 0.5 + ra[2, 1] * (va[1] + vb[1]) * 0.5 + ra[2, 2] * (va[2] + vb[2]) * 0.5 + s.position[a, 2]
+            area = min(m.edge_area[ea], m.edge_area[eb])
+            _add_contact(m, s, sc, row, beta, a, b, x0, x1, x2, s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2], area)
+            continue
+        ft = s.pair_target_face[i]
+        t = m.face_block[ft]
         rt = sc.rotation[t]
-        ro = sc.rotation[o]
-        fn = m.face_normal[tf]
+        fn = m.face_normal[ft]
         n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
         n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
         n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
-        pl = m.point_local[p]
-        a0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2]
-        a1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2]
-        a2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2]
-        b0 = a0 + s.position[o, 0] - s.position[t, 0]
-        b1 = a1 + s.position[o, 1] - s.position[t, 1]
-        b2 = a2 + s.position[o, 2] - s.position[t, 2]
-        # Two unit tangents of the contact plane.
-        if abs(n0) < 0.9:
-            u0, u1, u2 = 0.0, n2, -n1
-        else:
-            u0, u1, u2 = -n2, 0.0, n0
-        inv = 1.0 / math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-        u0, u1, u2 = u0 * inv, u1 * inv, u2 * inv
-        w0, w1, w2 = n1 * u2 - n2 * u1, n2 * u0 - n0 * u2, n0 * u1 - n1 * u0
-        kn_ = m.mat_kn[go, gt] * area
-        ks_ = m.mat_ks[go, gt] * area
-        for dir_ in range(3):
-            if dir_ == 0:
-                d0, d1, d2, k_ = n0, n1, n2, kn_
-            elif dir_ == 1:
-                d0, d1, d2, k_ = u0, u1, u2, ks_
-            else:
-                d0, d1, d2, k_ = w0, w1, w2, ks_
-            uo = math.sqrt(k_ * _flex(ro, m.block_inv_mass[o], m.block_inv_inertia[o], a0, a1, a2, d0, d1, d2))
-            ut = math.sqrt(k_ * _flex(rt, m.block_inv_mass[t], m.block_inv_inertia[t], b0, b1, b2, d0, d1, d2))
-            row[o] += uo * (uo + ut)
-            row[t] += ut * (ut + uo)
-        bt = m.mat_beta[go, gt]
-        beta[o] = max(beta[o], bt)
-        beta[t] = max(beta[t], bt)
-    out[0] = np.inf
-    out[1] = 0.0
-    out[2] = 1.0
+        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            p = s.track[k] // SLOTS
+            o = m.point_block[p]
+            ro = sc.rotation[o]
+            pl = m.point_local[p]
+            x0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2] + s.position[o, 0]
+            x1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2] + s.position[o, 1]
+            x2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2] + s.position[o, 2]
+            _add_contact(m, s, sc, row, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p])
+    dt_crit = np.inf
+    omega = 0.0
+    factor = 1.0
     for b in range(nb):
         if not m.block_free[b] or row[b] <= 0.0:
             continue
         w = math.sqrt(row[b])
         f = sp_critical_factor(beta[b], w)
         dtb = 2.0 / w * f
-        if dtb < out[0]:
-            out[0] = dtb
-            out[1] = w
-            out[2] = f
+        if dtb < dt_crit:
+            dt_crit, omega, factor = dtb, w, f
+    return dt_crit, omega, factor

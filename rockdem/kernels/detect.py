@@ -1,21 +1,55 @@
-"""Contact detection: bounding-box broad phase and common-plane narrow phase (DESIGN §2).
+"""Contact detection: bounding-box broad phase, separating-axis narrow phase, sub-contact slots.
 
-For each candidate pair the face normals of both blocks are tried as separating axes; the axis of
-largest separation is the common plane (its face is the *reference* face), and the face of the
-other block most opposed to it is the *incident* face. The interface points of the smaller of the
-two faces (tie: the lower block id) are the sub-contacts; they are tested against the other
-(target) face: within ``contact_tol`` of its plane and inside its polygon. A point has at most one
-partner; its persistent state (shear force, bond, failure) survives while the partner stays the
-same. Edge-to-edge crossings (no face normal separates) are not resolved: a documented limitation.
+For each pair of blocks whose bounding boxes (grown by the tracking tolerance) overlap, every
+candidate separating axis is tried: the face normals of both blocks and the cross products of
+their edge directions. The axis of largest separation decides (face axes win ties):
+
+* separation above the tolerance: the blocks are apart, no contact;
+* a face normal: a FACE pair. Its reference face is that face; the *incident* face is the face of
+  the other block most opposed to it. The smaller of the two (tie: lower block id) is the *owner*:
+  its interface points whose tributary cells the other (*target*) face covers, within the
+  tolerance, become sub-contacts (:mod:`rockdem.kernels.faces`);
+* an edge x edge axis: an EDGE pair, one point contact between the two edges (crossing edges,
+  ridge on ridge).
+
+A point holds up to ``SLOTS`` partners at once (a point on the line where two partner faces meet
+covers both). A slot keeps its history (shear, bond) while its partner block stays the same;
+a slot whose partner is gone is released (a bond torn off counts as a tension failure, stored
+shear energy as friction). Tracked sub-contacts are listed pair by pair in the pair order, which
+is fixed by the broad phase, so the force accumulation order (and the results) are deterministic.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
-from .layout import FAILED_SHEAR, FAILED_TENSION, ModelArrays, Scratch, State
+from .faces import cover, face_map
+from .layout import (
+    E_BOND,
+    E_FRICTION,
+    FAILED_SHEAR,
+    FAILED_TENSION,
+    PAIR_EDGE,
+    PAIR_FACE,
+    SLOTS,
+    ModelArrays,
+    Scratch,
+    State,
+)
 from .rotation import quat_to_matrix
+
+EDGE_AXIS_BIAS = 1e-3
+"""An edge x edge axis must separate by more than the best face axis plus this fraction of the
+tracking tolerance to be chosen (face axes win ties: an edge resting on a face is a face contact)."""
+
+EDGE_AXIS_MARGIN = 0.5
+"""... and plus this fraction of the face axis' overlap: an edge lying across a face, whose edge
+axes nearly match the face normal, stays a face contact (its sub-contacts hold it where it crosses
+the face), while crossing edges, whose face axes overlap far more than their edge axis, are
+edge-edge contacts. Without the margin a tilting edge flips between the two representations."""
 
 
 @njit(cache=True)
@@ -49,150 +83,368 @@ def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
             sc.aabb[b, 3 + i] += m.contact_tol
 
 
-@njit(cache=True)
-def _face_separation(
-    r: np.ndarray, pos: np.ndarray, normal: np.ndarray, offset: float, world_vertex: np.ndarray, v0: int, v1: int
-) -> float:
-    """Separation [m] of the vertices v0:v1 from a face (body normal, offset) of a block at (r, pos)."""
-    n0 = r[0, 0] * normal[0] + r[0, 1] * normal[1] + r[0, 2] * normal[2]
-    n1 = r[1, 0] * normal[0] + r[1, 1] * normal[1] + r[1, 2] * normal[2]
-    n2 = r[2, 0] * normal[0] + r[2, 1] * normal[1] + r[2, 2] * normal[2]
-    d = n0 * pos[0] + n1 * pos[1] + n2 * pos[2] + offset
+@njit(cache=True, inline="always")
+def _extent(wv: np.ndarray, v0: int, v1: int, ax: float, ay: float, az: float) -> tuple[float, float]:
     lo = np.inf
+    hi = -np.inf
     for v in range(v0, v1):
-        x = n0 * world_vertex[v, 0] + n1 * world_vertex[v, 1] + n2 * world_vertex[v, 2]
+        x = ax * wv[v, 0] + ay * wv[v, 1] + az * wv[v, 2]
         lo = min(lo, x)
-    return lo - d
+        hi = max(hi, x)
+    return lo, hi
 
 
-@njit(cache=True, inline="always")
-def point_in_target(
-    m: ModelArrays, s: State, sc: Scratch, p: int, t: int, tf: int, out: np.ndarray
-) -> float:
-    """Gap of point p from face tf of block t [m] (negative = overlap) and its position in t's frame.
+@njit(cache=True)
+def separating_axes(
+    m: ModelArrays, s: State, sc: Scratch, a: int, b: int
+) -> tuple[float, int, int, int, int, int, float, float, float]:
+    """Best separating axis of blocks a and b (world vertices must be current).
 
-    ``out[:3]`` receives the point in the target body frame; ``out[3]`` the largest excursion
-    outside the face polygon [m] (<= 0 inside).
+    Returns (separation [m], kind, reference block, reference face, direction id of a, direction id
+    of b, axis x, y, z). For a face axis the axis is the reference face's world normal; for an
+    edge axis it points from b towards a.
     """
-    o = m.point_block[p]
-    ro = sc.rotation[o]
-    rt = sc.rotation[t]
-    pl = m.point_local[p]
-    w0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2] + s.position[o, 0] - s.position[t, 0]
-    w1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2] + s.position[o, 1] - s.position[t, 1]
-    w2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2] + s.position[o, 2] - s.position[t, 2]
-    q0 = rt[0, 0] * w0 + rt[1, 0] * w1 + rt[2, 0] * w2
-    q1 = rt[0, 1] * w0 + rt[1, 1] * w1 + rt[2, 1] * w2
-    q2 = rt[0, 2] * w0 + rt[1, 2] * w1 + rt[2, 2] * w2
-    out[0], out[1], out[2] = q0, q1, q2
-    outside = -np.inf
-    for e in range(m.face_edge_start[tf], m.face_edge_start[tf + 1]):
-        d = m.edge_normal[e, 0] * q0 + m.edge_normal[e, 1] * q1 + m.edge_normal[e, 2] * q2 - m.edge_offset[e]
-        outside = max(outside, d)
-    out[3] = outside
-    n = m.face_normal[tf]
-    return n[0] * q0 + n[1] * q1 + n[2] * q2 - m.face_offset[tf]
-
-
-@njit(cache=True, inline="always")
-def _release(s: State, p: int) -> None:
-    """Forget the partner of point p; a bond torn apart by separation counts as a tension failure."""
-    if s.point_bonded[p]:
-        s.point_bonded[p] = False
-        s.point_failed[p] = FAILED_TENSION
-    s.point_partner[p] = -1
-    s.point_target_face[p] = -1
-    s.point_shear[p, 0] = 0.0
-    s.point_shear[p, 1] = 0.0
-    s.point_shear[p, 2] = 0.0
-    s.point_normal_force[p] = 0.0
-
-
-@njit(cache=True, inline="always")
-def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, tmp: np.ndarray) -> None:
     best = -np.inf
+    kind = PAIR_FACE
     ref = -1
     rface = -1
-    for f in range(m.block_face_start[a], m.block_face_start[a + 1]):
-        sep = _face_separation(
-            sc.rotation[a], s.position[a], m.face_normal[f], m.face_offset[f], sc.world_vertex,
-            m.block_vertex_start[b], m.block_vertex_start[b + 1],
+    da = -1
+    db = -1
+    nx = ny = nz = 0.0
+    wv = sc.world_vertex
+    for side in range(2):
+        r_, o_ = (a, b) if side == 0 else (b, a)
+        rr = sc.rotation[r_]
+        for f in range(m.block_face_start[r_], m.block_face_start[r_ + 1]):
+            fn = m.face_normal[f]
+            n0 = rr[0, 0] * fn[0] + rr[0, 1] * fn[1] + rr[0, 2] * fn[2]
+            n1 = rr[1, 0] * fn[0] + rr[1, 1] * fn[1] + rr[1, 2] * fn[2]
+            n2 = rr[2, 0] * fn[0] + rr[2, 1] * fn[1] + rr[2, 2] * fn[2]
+            d = n0 * s.position[r_, 0] + n1 * s.position[r_, 1] + n2 * s.position[r_, 2] + m.face_offset[f]
+            lo, _ = _extent(wv, m.block_vertex_start[o_], m.block_vertex_start[o_ + 1], n0, n1, n2)
+            if lo - d > best:
+                best, ref, rface = lo - d, r_, f
+                nx, ny, nz = n0, n1, n2
+    bias = EDGE_AXIS_BIAS * m.contact_tol + 1e-12 + EDGE_AXIS_MARGIN * max(-best, 0.0)
+    ra = sc.rotation[a]
+    rb = sc.rotation[b]
+    for i in range(m.block_dir_start[a], m.block_dir_start[a + 1]):
+        di = m.dir_local[i]
+        a0 = ra[0, 0] * di[0] + ra[0, 1] * di[1] + ra[0, 2] * di[2]
+        a1 = ra[1, 0] * di[0] + ra[1, 1] * di[1] + ra[1, 2] * di[2]
+        a2 = ra[2, 0] * di[0] + ra[2, 1] * di[1] + ra[2, 2] * di[2]
+        for j in range(m.block_dir_start[b], m.block_dir_start[b + 1]):
+            dj = m.dir_local[j]
+            b0 = rb[0, 0] * dj[0] + rb[0, 1] * dj[1] + rb[0, 2] * dj[2]
+            b1 = rb[1, 0] * dj[0] + rb[1, 1] * dj[1] + rb[1, 2] * dj[2]
+            b2 = rb[2, 0] * dj[0] + rb[2, 1] * dj[1] + rb[2, 2] * dj[2]
+            l0, l1, l2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+            ln = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+            if ln < 1e-6:
+                continue
+            l0, l1, l2 = l0 / ln, l1 / ln, l2 / ln
+            alo, ahi = _extent(wv, m.block_vertex_start[a], m.block_vertex_start[a + 1], l0, l1, l2)
+            blo, bhi = _extent(wv, m.block_vertex_start[b], m.block_vertex_start[b + 1], l0, l1, l2)
+            s1 = alo - bhi  # a on the + side
+            s2 = blo - ahi  # a on the - side
+            sep = max(s1, s2)
+            if sep > best + bias:
+                best, kind, da, db = sep, PAIR_EDGE, i, j
+                bias = 0.0
+                sign = 1.0 if s1 >= s2 else -1.0
+                nx, ny, nz = sign * l0, sign * l1, sign * l2
+    return best, kind, ref, rface, da, db, nx, ny, nz
+
+
+@njit(cache=True)
+def _supporting_edge(m: ModelArrays, sc: Scratch, blk: int, i: int, nx: float, ny: float, nz: float, lowest: bool) -> int:
+    """The edge of ``blk`` parallel to its edge direction ``i`` furthest along -n (``lowest``) or +n."""
+    r = sc.rotation[blk]
+    dl = m.dir_local[i]
+    e0 = r[0, 0] * dl[0] + r[0, 1] * dl[1] + r[0, 2] * dl[2]
+    e1 = r[1, 0] * dl[0] + r[1, 1] * dl[1] + r[1, 2] * dl[2]
+    e2 = r[2, 0] * dl[0] + r[2, 1] * dl[1] + r[2, 2] * dl[2]
+    best = np.inf
+    out = -1
+    for e in range(m.block_edge_start[blk], m.block_edge_start[blk + 1]):
+        v0 = m.edge_vertex[e, 0]
+        v1 = m.edge_vertex[e, 1]
+        d0 = sc.world_vertex[v1, 0] - sc.world_vertex[v0, 0]
+        d1 = sc.world_vertex[v1, 1] - sc.world_vertex[v0, 1]
+        d2 = sc.world_vertex[v1, 2] - sc.world_vertex[v0, 2]
+        ln = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if abs(d0 * e0 + d1 * e1 + d2 * e2) < (1.0 - 1e-6) * ln:
+            continue
+        h = 0.5 * (
+            nx * (sc.world_vertex[v0, 0] + sc.world_vertex[v1, 0])
+            + ny * (sc.world_vertex[v0, 1] + sc.world_vertex[v1, 1])
+            + nz * (sc.world_vertex[v0, 2] + sc.world_vertex[v1, 2])
         )
-        if sep > best:
-            best, ref, rface = sep, a, f
-    for f in range(m.block_face_start[b], m.block_face_start[b + 1]):
-        sep = _face_separation(
-            sc.rotation[b], s.position[b], m.face_normal[f], m.face_offset[f], sc.world_vertex,
-            m.block_vertex_start[a], m.block_vertex_start[a + 1],
-        )
-        if sep > best:
-            best, ref, rface = sep, b, f
-    if best < sc.sums[5]:
-        sc.sums[5] = best
-        sc.sums[6] = a
-        sc.sums[7] = b
-    if best > m.contact_tol:
-        return
-    oth = b if ref == a else a
-    rr = sc.rotation[ref]
-    ro = sc.rotation[oth]
-    fr = m.face_normal[rface]
-    nref0 = rr[0, 0] * fr[0] + rr[0, 1] * fr[1] + rr[0, 2] * fr[2]
-    nref1 = rr[1, 0] * fr[0] + rr[1, 1] * fr[1] + rr[1, 2] * fr[2]
-    nref2 = rr[2, 0] * fr[0] + rr[2, 1] * fr[1] + rr[2, 2] * fr[2]
-    iface = -1
+        key = h if lowest else -h
+        if key < best:
+            best, out = key, e
+    return out
+
+
+INCIDENT_HYSTERESIS = 0.05
+"""The incident face of the last detection is kept while its normal is within this much (cosine)
+of the most opposed one: a block rocking on an edge between two of its faces does not switch
+the face carrying its sub-contacts back and forth (each switch re-represents a loaded contact)."""
+
+
+@njit(cache=True)
+def _previous_pair(m: ModelArrays, sc: Scratch, a: int, b: int) -> int:
+    """Index of pair (a, b) at the previous detection, -1 if it was not a pair (binary search)."""
+    key = a * m.block_mass.shape[0] + b
+    lo = 0
+    hi = sc.prev_pair_count[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if sc.prev_pair_key[mid] < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    if lo < sc.prev_pair_count[0] and sc.prev_pair_key[lo] == key:
+        return sc.prev_pair_index[lo]
+    return -1
+
+
+@njit(cache=True, inline="always")
+def _facing(r: np.ndarray, fn: np.ndarray, nx: float, ny: float, nz: float) -> float:
+    return (
+        (r[0, 0] * fn[0] + r[0, 1] * fn[1] + r[0, 2] * fn[2]) * nx
+        + (r[1, 0] * fn[0] + r[1, 1] * fn[1] + r[1, 2] * fn[2]) * ny
+        + (r[2, 0] * fn[0] + r[2, 1] * fn[1] + r[2, 2] * fn[2]) * nz
+    )
+
+
+@njit(cache=True)
+def _incident_face(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, previous: int) -> int:
+    """Face of ``blk`` most opposed to the world direction n, or ``previous`` (a face of blk, or
+    -1) while it stays within INCIDENT_HYSTERESIS of it."""
+    r = sc.rotation[blk]
     lowest = np.inf
-    for g in range(m.block_face_start[oth], m.block_face_start[oth + 1]):
-        c = (
-            (ro[0, 0] * m.face_normal[g, 0] + ro[0, 1] * m.face_normal[g, 1] + ro[0, 2] * m.face_normal[g, 2]) * nref0
-            + (ro[1, 0] * m.face_normal[g, 0] + ro[1, 1] * m.face_normal[g, 1] + ro[1, 2] * m.face_normal[g, 2]) * nref1
-            + (ro[2, 0] * m.face_normal[g, 0] + ro[2, 1] * m.face_normal[g, 1] + ro[2, 2] * m.face_normal[g, 2]) * nref2
-        )
+    out = -1
+    for g in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
+        c = _facing(r, m.face_normal[g], nx, ny, nz)
         if c < lowest:
-            lowest, iface = c, g
+            lowest, out = c, g
+    if previous >= 0 and previous != out and _facing(r, m.face_normal[previous], nx, ny, nz) <= lowest + INCIDENT_HYSTERESIS:
+        return previous
+    return out
+
+
+@njit(cache=True)
+def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -> int:
+    """Narrow phase of pair (a, b), a < b: adds a pair and its candidate sub-contacts; returns the
+    new candidate count."""
+    sep, kind, ref, rface, da, db, nx, ny, nz = separating_axes(m, s, sc, a, b)
+    if sep < sc.min_separation[0]:
+        sc.min_separation[0] = sep
+        sc.min_pair[0] = a
+        sc.min_pair[1] = b
+    if sep > m.contact_tol:
+        return ncand
+    i = s.pair_count[0]
+    if i >= s.pair_a.shape[0]:
+        sc.overflow[0] += 1
+        return ncand
+    s.pair_count[0] = i + 1
+    s.pair_a[i] = a
+    s.pair_b[i] = b
+    s.pair_kind[i] = kind
+    s.pair_track_start[i] = ncand
+    s.pair_track_stop[i] = ncand
+    if kind == PAIR_EDGE:
+        ea = _supporting_edge(m, sc, a, da, nx, ny, nz, True)
+        eb = _supporting_edge(m, sc, b, db, nx, ny, nz, False)
+        s.pair_edge_a[i] = ea
+        s.pair_edge_b[i] = eb
+        s.pair_normal[i, 0] = nx
+        s.pair_normal[i, 1] = ny
+        s.pair_normal[i, 2] = nz
+        s.pair_shear[i, :] = 0.0
+        s.pair_normal_force[i] = 0.0
+        s.pair_overlap[i] = 0.0
+        k = _previous_pair(m, sc, a, b)  # carry the history of the same edge contact
+        if k >= 0 and sc.prev_pair_kind[k] == PAIR_EDGE and sc.prev_pair_edge_a[k] == ea and sc.prev_pair_edge_b[k] == eb:
+            sc.prev_pair_kept[k] = True
+            s.pair_shear[i, :] = sc.prev_pair_shear[k]
+            s.pair_normal_force[i] = sc.prev_pair_normal_force[k]
+            s.pair_overlap[i] = sc.prev_pair_overlap[k]
+        return ncand
+    oth = b if ref == a else a
+    prev = _previous_pair(m, sc, a, b)
+    keep = -1
+    if prev >= 0:
+        sc.prev_pair_kept[prev] = True
+        if sc.prev_pair_kind[prev] == PAIR_FACE:
+            for f in (sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]):
+                if m.face_block[f] == oth:
+                    keep = f
+    iface = _incident_face(m, sc, oth, nx, ny, nz, keep)
     ar = m.face_area[rface]
     ai = m.face_area[iface]
     # The smaller face owns the points (tie: the lower block id).
     if ai < ar * (1.0 - 1e-9) or (ar >= ai * (1.0 - 1e-9) and oth < ref):
-        oface, target, tface = iface, ref, rface
+        fo, ft = iface, rface
     else:
-        oface, target, tface = rface, oth, iface
+        fo, ft = rface, iface
+    s.pair_owner_face[i] = fo
+    s.pair_target_face[i] = ft
+    fm = face_map(m, s, sc, fo, ft)
+    if abs(fm.det) < 1e-9:
+        return ncand
+    partner = m.face_block[ft]
+    for p in range(m.face_point_start[fo], m.face_point_start[fo + 1]):
+        area, yu, yw = cover(m, sc, p, ft, fm, m.contact_tol)
+        if area <= 0.0:
+            continue
+        if fm.h0 + fm.hu * yu + fm.hw * yw > m.contact_tol:
+            continue
+        if ncand >= sc.cand_code.shape[0]:
+            sc.overflow[0] += 1
+            break
+        sc.cand_code[ncand] = p
+        sc.cand_partner[ncand] = partner
+        sc.cand_face[ncand] = ft
+        ncand += 1
+    s.pair_track_stop[i] = ncand
+    return ncand
+
+
+@njit(cache=True)
+def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
+    """Forget slot k of point p: a bond torn off counts as a tension failure; the energy still
+    stored in its springs is dissipated (bond energy for a bond, friction otherwise)."""
+    t = s.slot_partner[p, k]
+    if t < 0:
+        return
+    go = m.block_group[m.point_block[p]]
+    gt = m.block_group[t]
+    area = s.slot_area[p, k]
+    e = 0.0
+    if area > 0.0:
+        ks = m.mat_ks[go, gt] * area
+        sh = s.slot_shear[p, k]
+        e += 0.5 * ks * (sh[0] * sh[0] + sh[1] * sh[1] + sh[2] * sh[2])
+        fn = s.slot_normal_force[p, k]
+        e += 0.5 * fn * fn / (m.mat_kn[go, gt] * area)
+    if s.slot_bonded[p, k]:
+        s.slot_bonded[p, k] = False
+        s.point_failed[p] = FAILED_TENSION
+        s.energy[E_BOND] += e
+    else:
+        s.energy[E_FRICTION] += e
+    s.slot_partner[p, k] = -1
+    s.slot_face[p, k] = -1
+    s.slot_shear[p, k, :] = 0.0
+    s.slot_normal_force[p, k] = 0.0
+    s.slot_area[p, k] = 0.0
+    s.slot_overlap[p, k] = 0.0
+
+
+@njit(cache=True)
+def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
+    """Give each candidate a slot of its point (its old one for the same partner), release the
+    slots not found again, and list the tracked sub-contacts pair by pair."""
     passid = sc.passes[0]
-    for p in range(m.face_point_start[oface], m.face_point_start[oface + 1]):
-        gap = point_in_target(m, s, sc, p, target, tface, tmp)
-        if gap > m.contact_tol or tmp[3] > m.contact_tol + max(-gap, 0.0):
+    for c in range(ncand):
+        p = sc.cand_code[c]
+        sc.cand_slot[c] = -1
+        for k in range(SLOTS):
+            if s.slot_partner[p, k] == sc.cand_partner[c] and sc.seen[SLOTS * p + k] != passid:
+                sc.cand_slot[c] = k
+                sc.seen[SLOTS * p + k] = passid
+                if s.slot_face[p, k] != sc.cand_face[c]:
+                    # Another face of the same partner: a new joint plane, the shear spring restarts
+                    # (its energy is dissipated) and a bond is sheared off.
+                    go, gt = m.block_group[m.point_block[p]], m.block_group[sc.cand_partner[c]]
+                    sh = s.slot_shear[p, k]
+                    e = 0.5 * m.mat_ks[go, gt] * s.slot_area[p, k] * (sh[0] * sh[0] + sh[1] * sh[1] + sh[2] * sh[2])
+                    if s.slot_bonded[p, k]:
+                        s.slot_bonded[p, k] = False
+                        s.point_failed[p] = FAILED_SHEAR
+                        s.energy[E_BOND] += e
+                    else:
+                        s.energy[E_FRICTION] += e
+                    s.slot_face[p, k] = sc.cand_face[c]
+                    s.slot_shear[p, k, :] = 0.0
+                break
+    for p in range(m.point_block.shape[0]):
+        for k in range(SLOTS):
+            if s.slot_partner[p, k] >= 0 and sc.seen[SLOTS * p + k] != passid:
+                release_slot(m, s, p, k)
+    for c in range(ncand):
+        if sc.cand_slot[c] >= 0:
             continue
-        if sc.seen[p] == passid:
-            # Claimed already by another pair (a point on the shared edge of two faces): the
-            # previous partner keeps it, so that bonds do not flip between neighbours.
-            if target == sc.prev_partner[p]:
-                s.point_partner[p] = target
-                s.point_target_face[p] = tface
+        p = sc.cand_code[c]
+        for k in range(SLOTS):
+            if s.slot_partner[p, k] < 0 and sc.seen[SLOTS * p + k] != passid:
+                s.slot_partner[p, k] = sc.cand_partner[c]
+                s.slot_face[p, k] = sc.cand_face[c]
+                s.slot_shear[p, k, :] = 0.0
+                s.slot_normal_force[p, k] = 0.0
+                s.slot_area[p, k] = 0.0
+                s.slot_overlap[p, k] = 0.0
+                sc.seen[SLOTS * p + k] = passid
+                sc.cand_slot[c] = k
+                break
+    n = 0
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] != PAIR_FACE:
             continue
-        sc.seen[p] = passid
-        s.point_partner[p] = target
-        s.point_target_face[p] = tface
-        s.track[s.track_count[0]] = p
-        s.track_count[0] += 1
+        c0 = s.pair_track_start[i]
+        c1 = s.pair_track_stop[i]
+        s.pair_track_start[i] = n
+        for c in range(c0, c1):
+            if sc.cand_slot[c] >= 0:
+                s.track[n] = SLOTS * sc.cand_code[c] + sc.cand_slot[c]
+                n += 1
+        s.pair_track_stop[i] = n
+    s.track_count[0] = n
 
 
 @njit(cache=True)
 def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
-    """Rebuild the list of tracked sub-contacts at the current poses (rotations must be current).
+    """Rebuild the pairs and the tracked sub-contacts at the current poses (rotations current).
 
-    Also leaves the most negative pair separation (deepest overlap) and its blocks in
-    ``sc.sums[5:8]`` for the start-of-run overlap check.
+    Also leaves the smallest pair separation (the deepest overlap when negative) and its blocks in
+    ``sc.min_separation`` and ``sc.min_pair`` for the start-of-run overlap check, and counts
+    buffer overflows in ``sc.overflow`` (the caller enlarges the buffers and detects again).
     """
     nb = m.block_mass.shape[0]
     _world_vertices(m, s, sc)
     sc.passes[0] += 1
-    s.track_count[0] = 0
-    sc.prev_partner[:] = s.point_partner
-    sc.sums[5] = np.inf
-    sc.sums[6] = -1
-    sc.sums[7] = -1
-    tmp = np.empty(4)
-    order = np.argsort(sc.aabb[:, 0])
+    npair = s.pair_count[0]
+    sc.prev_pair_count[0] = npair
+    for i in range(npair):
+        sc.prev_pair_a[i] = s.pair_a[i]
+        sc.prev_pair_b[i] = s.pair_b[i]
+        sc.prev_pair_kind[i] = s.pair_kind[i]
+        sc.prev_pair_owner_face[i] = s.pair_owner_face[i]
+        sc.prev_pair_target_face[i] = s.pair_target_face[i]
+        sc.prev_pair_edge_a[i] = s.pair_edge_a[i]
+        sc.prev_pair_edge_b[i] = s.pair_edge_b[i]
+        sc.prev_pair_normal_force[i] = s.pair_normal_force[i]
+        sc.prev_pair_overlap[i] = s.pair_overlap[i]
+        for k in range(3):
+            sc.prev_pair_shear[i, k] = s.pair_shear[i, k]
+            sc.prev_pair_normal[i, k] = s.pair_normal[i, k]
+        sc.prev_pair_kept[i] = False
+        sc.prev_pair_key[i] = s.pair_a[i] * nb + s.pair_b[i]
+    order = np.argsort(sc.prev_pair_key[:npair])
+    keys = sc.prev_pair_key[:npair].copy()
+    for i in range(npair):
+        sc.prev_pair_key[i] = keys[order[i]]
+        sc.prev_pair_index[i] = order[i]
+    s.pair_count[0] = 0
+    sc.min_separation[0] = np.inf
+    sc.min_pair[0] = -1
+    sc.min_pair[1] = -1
+    sc.overflow[0] = 0
+    ncand = 0
+    order = np.argsort(sc.aabb[:, 0], kind="mergesort")
     for ii in range(nb):
         a = order[ii]
         for jj in range(ii + 1, nb):
@@ -209,21 +461,26 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
             if not (m.block_free[a] or m.block_free[b]):
                 continue
             lo, hi = (a, b) if a < b else (b, a)
-            _narrow(m, s, sc, lo, hi, tmp)
-    passid = sc.passes[0]
-    for p in range(m.point_block.shape[0]):
-        if s.point_partner[p] >= 0 and sc.seen[p] != passid:
-            _release(s, p)
-        elif sc.seen[p] == passid and sc.prev_partner[p] >= 0 and s.point_partner[p] != sc.prev_partner[p]:
-            # Moved on to another block: a bond is sheared off, the shear spring starts anew.
-            if s.point_bonded[p]:
-                s.point_bonded[p] = False
-                s.point_failed[p] = FAILED_SHEAR
-            s.point_shear[p, 0] = 0.0
-            s.point_shear[p, 1] = 0.0
-            s.point_shear[p, 2] = 0.0
-            s.point_normal_force[p] = 0.0
-    # Sort the tracked list so that force accumulation order (and results) are deterministic.
-    s.track[: s.track_count[0]].sort()
+            ncand = _narrow(m, s, sc, lo, hi, ncand)
+    _release_lost_edges(m, s, sc)
+    _assign_slots(m, s, sc, ncand)
     for b in range(nb):
         s.moved[b] = 0.0
+
+
+@njit(cache=True)
+def _release_lost_edges(m: ModelArrays, s: State, sc: Scratch) -> None:
+    """Edge contacts of the previous detection not found again: their stored spring energy is
+    dissipated (friction)."""
+    for k in range(sc.prev_pair_count[0]):
+        if sc.prev_pair_kind[k] != PAIR_EDGE or sc.prev_pair_kept[k]:
+            continue
+        a = sc.prev_pair_a[k]
+        b = sc.prev_pair_b[k]
+        area = min(m.edge_area[sc.prev_pair_edge_a[k]], m.edge_area[sc.prev_pair_edge_b[k]])
+        g0, g1 = m.block_group[a], m.block_group[b]
+        sh = sc.prev_pair_shear[k]
+        e = 0.5 * m.mat_ks[g0, g1] * area * (sh[0] * sh[0] + sh[1] * sh[1] + sh[2] * sh[2])
+        fn = sc.prev_pair_normal_force[k]
+        e += 0.5 * fn * fn / (m.mat_kn[g0, g1] * area)
+        s.energy[E_FRICTION] += e

@@ -1,8 +1,15 @@
 """Flat struct-of-arrays layouts passed into the kernels (NamedTuples pass into Numba and pickle).
 
-Index conventions: ``block_*_start`` arrays have length count+1 (CSR style); the faces of block b
-are ``block_face_start[b]:block_face_start[b+1]``, and likewise for vertices, face edges and face
-points. Body frames are principal frames with the origin at the centroid.
+Index conventions: ``*_start`` arrays have length count+1 (CSR style); the faces of block b are
+``block_face_start[b]:block_face_start[b+1]``, and likewise for vertices, edges, edge directions,
+face corners, face edge lines, face points and point cell vertices. Body frames are principal
+frames with the origin at the centroid. Every face has a 2D frame (origin, u "across", w "along",
+with u, w, normal right-handed); "face coordinates" are (u, w) in it.
+
+Contacts (see ``docs/contacts.md``): a *pair* is two blocks found close by the narrow phase. A
+FACE pair carries sub-contacts: interface points of its *owner* face, each with one of the two
+*slots* of its point, pressed against the *target* face of the other block. An EDGE pair is one
+point contact between an edge of each block. Slot k of point p is the contact code ``2 p + k``.
 """
 
 from __future__ import annotations
@@ -15,6 +22,19 @@ import numpy as np
 FAILED_NONE = 0
 FAILED_TENSION = 1
 FAILED_SHEAR = 2
+
+# Kinds of pairs.
+PAIR_FACE = 0
+PAIR_EDGE = 1
+
+SLOTS = 2
+"""Partners a point can hold at once (a point on the shared edge of two faces of its partners)."""
+
+# Status returned by the stepping loop.
+STATUS_DONE = 0
+STATUS_GROW = 1  # the pair or candidate buffers are full: enlarge them and continue
+STATUS_DIVERGED = 2  # energy balance broken or a non-finite state
+STATUS_LOST = 3  # a free block left the model's extent (fell through its support or flew away)
 
 # Energy accumulator slots (State.energy) and recorded energy columns.
 E_KINETIC = 0
@@ -62,17 +82,31 @@ class ModelArrays(NamedTuple):
     block_radius: np.ndarray  # (nb,) [m] largest vertex distance from the centroid
     block_vertex_start: np.ndarray  # (nb+1,)
     vertex_local: np.ndarray  # (nv, 3) [m], body frame
+    block_edge_start: np.ndarray  # (nb+1,)
+    edge_vertex: np.ndarray  # (ne, 2) int64 global vertex ids of each edge
+    edge_area: np.ndarray  # (ne,) [m^2] contact area of an edge-edge contact on this edge
+    block_dir_start: np.ndarray  # (nb+1,)
+    dir_local: np.ndarray  # (nd, 3) unit edge directions of each block, parallel edges merged
     block_face_start: np.ndarray  # (nb+1,)
+    face_block: np.ndarray  # (nf,) int64
     face_normal: np.ndarray  # (nf, 3) outward unit normal, body frame
     face_offset: np.ndarray  # (nf,) [m]: normal . x <= offset inside
     face_area: np.ndarray  # (nf,) [m^2]
-    face_edge_start: np.ndarray  # (nf+1,)
-    edge_normal: np.ndarray  # (ne, 3) in-plane outward normal of a face edge, body frame
-    edge_offset: np.ndarray  # (ne,) [m]
+    face_origin: np.ndarray  # (nf, 3) [m] origin of the face frame (a point of the face), body frame
+    face_u: np.ndarray  # (nf, 3) unit axis "across" of the face frame, body frame
+    face_w: np.ndarray  # (nf, 3) unit axis "along" of the face frame, body frame
+    face_corner_start: np.ndarray  # (nf+1,)
+    face_corner: np.ndarray  # (nc,) global vertex ids, counter-clockwise seen from outside
+    face_line_start: np.ndarray  # (nf+1,)
+    face_line: np.ndarray  # (nl, 3) polygon edges in face coordinates: lu u + lw w <= lo inside
     face_point_start: np.ndarray  # (nf+1,)
     point_local: np.ndarray  # (np, 3) [m], body frame
-    point_area: np.ndarray  # (np,) [m^2]
+    point_area: np.ndarray  # (np,) [m^2] tributary area (cell area)
     point_block: np.ndarray  # (np,) int64
+    point_face: np.ndarray  # (np,) int64
+    point_node: np.ndarray  # (np, 2) [m] the point in face coordinates
+    point_cell_start: np.ndarray  # (np+1,)
+    cell_vertex: np.ndarray  # (ncv, 2) [m] tributary cell polygons in face coordinates (CCW)
     mat_kn: np.ndarray  # (ng, ng) [Pa/m]
     mat_ks: np.ndarray  # (ng, ng) [Pa/m]
     mat_cohesion: np.ndarray  # (ng, ng) [Pa]
@@ -92,51 +126,103 @@ class ModelArrays(NamedTuple):
     ground_motion: int  # motion table of the ground, -1 = none
     body_time: np.ndarray  # (M,) [s]
     body_acceleration: np.ndarray  # (M, 3) [m/s^2] applied to free blocks (inertial loading)
-    contact_tol: float  # [m] gap within which points are tracked between detections
-    edge_tol: float  # [m] tolerance of the point-in-face test
+    contact_tol: float  # [m] gap within which contacts are tracked between detections
+    touch_tol: float  # [m] gap within which joints count as touching at the start (bonded)
+    extent_low: np.ndarray  # (3,) [m] lower corner of the model's extent (a free block leaving it is lost)
+    extent_high: np.ndarray  # (3,) [m] upper corner
 
 
 class State(NamedTuple):
     """Everything that changes during a run (arrays mutated in place by the kernels)."""
 
-    clock: np.ndarray  # (2,) [time s, dt s]
+    time: np.ndarray  # (1,) [s]
+    dt: np.ndarray  # (1,) [s] step to take next
+    dt_prev: np.ndarray  # (1,) [s] step just taken
+    dt_min: np.ndarray  # (1,) [s] smallest step used so far
+    safety: np.ndarray  # (1,) fraction of the stable bound used when the step is lowered
+    resolution: np.ndarray  # (1,) largest omega_max dt / 2 when the step is lowered (impact resolution)
     step: np.ndarray  # (1,) int64 steps taken
     position: np.ndarray  # (nb, 3) [m] centroid
     quaternion: np.ndarray  # (nb, 4) body -> world
     velocity: np.ndarray  # (nb, 3) [m/s] at the last half step
     omega: np.ndarray  # (nb, 3) [rad/s] body frame, last half step
-    point_partner: np.ndarray  # (np,) int64 target block, -1 none
-    point_target_face: np.ndarray  # (np,) int64
-    point_shear: np.ndarray  # (np, 3) [N] elastic shear force on the point's block, world
-    point_normal_force: np.ndarray  # (np,) [N] elastic normal force (compression > 0)
-    point_bonded: np.ndarray  # (np,) bool
+    slot_partner: np.ndarray  # (np, SLOTS) int64 partner block, -1 none
+    slot_face: np.ndarray  # (np, SLOTS) int64 target face
+    slot_shear: np.ndarray  # (np, SLOTS, 3) [m] elastic shear displacement, world (owner rel. target)
+    slot_normal_force: np.ndarray  # (np, SLOTS) [N] elastic normal force (compression > 0)
+    slot_area: np.ndarray  # (np, SLOTS) [m^2] effective area: the cell area the partner covers
+    slot_overlap: np.ndarray  # (np, SLOTS) [m] normal overlap at the last force pass (> 0 compression)
+    slot_bonded: np.ndarray  # (np, SLOTS) bool
     point_failed: np.ndarray  # (np,) int64 FAILED_*
     energy: np.ndarray  # (ENERGY_COUNT,) [J] accumulated dissipation and work
-    track: np.ndarray  # (np,) int64 tracked point ids
+    track: np.ndarray  # (SLOTS np,) int64 contact codes 2 p + k, grouped by pair
     track_count: np.ndarray  # (1,) int64
+    pair_count: np.ndarray  # (1,) int64
+    pair_a: np.ndarray  # (P,) int64 block a < b
+    pair_b: np.ndarray  # (P,) int64
+    pair_kind: np.ndarray  # (P,) int64 PAIR_FACE or PAIR_EDGE
+    pair_owner_face: np.ndarray  # (P,) int64 FACE: face whose points carry the sub-contacts
+    pair_target_face: np.ndarray  # (P,) int64 FACE: face they press on
+    pair_track_start: np.ndarray  # (P,) int64 FACE: its sub-contacts are track[start:stop]
+    pair_track_stop: np.ndarray  # (P,) int64
+    pair_edge_a: np.ndarray  # (P,) int64 EDGE: edge of block a
+    pair_edge_b: np.ndarray  # (P,) int64 EDGE: edge of block b
+    pair_normal: np.ndarray  # (P, 3) EDGE: contact normal, world, pointing from b to a
+    pair_shear: np.ndarray  # (P, 3) [m] EDGE: elastic shear displacement of a relative to b
+    pair_normal_force: np.ndarray  # (P,) [N] EDGE: elastic normal force
+    pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass
     moved: np.ndarray  # (nb,) [m] displacement bound since the last detection
 
 
 class Scratch(NamedTuple):
-    """Per-step work arrays (no meaning between steps)."""
+    """Per-step work arrays (no meaning between steps, except the detection buffers)."""
 
     rotation: np.ndarray  # (nb, 3, 3)
     force: np.ndarray  # (nb, 3) [N] world
     torque: np.ndarray  # (nb, 3) [N m] world, about the centroid
     world_vertex: np.ndarray  # (nv, 3)
     aabb: np.ndarray  # (nb, 6)
-    seen: np.ndarray  # (np,) int64 detection pass that claimed the point
-    prev_partner: np.ndarray  # (np,) int64 partner before the current detection pass
+    seen: np.ndarray  # (SLOTS np,) int64 detection pass that confirmed the slot
     passes: np.ndarray  # (1,) int64
-    sums: np.ndarray  # (8,) [0] elastic energy, [1] active count, [2:5] reaction, [5] min pair separation, [6:8] pair
+    elastic_energy: np.ndarray  # (1,) [J] stored in the contact springs at the last force pass
+    active_count: np.ndarray  # (1,) int64 contacts in compression (or bonded) at the last force pass
+    reaction: np.ndarray  # (3,) [N] force of the driven blocks on the free blocks
+    min_separation: np.ndarray  # (1,) [m] smallest pair separation at the last detection (< 0: overlap)
+    min_pair: np.ndarray  # (2,) int64 the two blocks of that pair
+    overflow: np.ndarray  # (1,) int64 > 0: the pair or candidate buffers were too small
     ground_velocity: np.ndarray  # (3,) [m/s]
     body_acc: np.ndarray  # (3,) [m/s^2]
+    driven_velocity: np.ndarray  # (3,) [m/s] prescribed velocity of the driven block being integrated
     omega_world: np.ndarray  # (nb, 3) [rad/s]
-    point_tmp: np.ndarray  # (4,)
-    dashpot_force: np.ndarray  # (np, 3) [N] SP dashpot force on the point's block, per tracked slot
-    dashpot_point: np.ndarray  # (np, 3) [m] contact point of that dashpot, world
+    dashpot_force: np.ndarray  # (SLOTS np, 3) [N] SP dashpot force on the owner, per track entry
+    dashpot_point: np.ndarray  # (SLOTS np, 3) [m] world point of that dashpot
+    pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: dashpot force on block a
+    pair_dashpot_point: np.ndarray  # (P, 3) [m]
     velocity_mid: np.ndarray  # (nb, 3) [m/s] step mid-point velocity
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
+    poly_a: np.ndarray  # (16, 2) clipping buffer
+    poly_b: np.ndarray  # (16, 2) clipping buffer
+    cand_code: np.ndarray  # (C,) int64 detection: candidate point p (slot assigned later)
+    cand_partner: np.ndarray  # (C,) int64
+    cand_face: np.ndarray  # (C,) int64 target face
+    cand_slot: np.ndarray  # (C,) int64 slot given to the candidate, -1 none
+    prev_pair_count: np.ndarray  # (1,) int64 previous detection's pairs (for edge-contact history)
+    prev_pair_a: np.ndarray  # (P,) int64
+    prev_pair_b: np.ndarray  # (P,) int64
+    prev_pair_kind: np.ndarray  # (P,) int64
+    prev_pair_owner_face: np.ndarray  # (P,) int64
+    prev_pair_target_face: np.ndarray  # (P,) int64
+    prev_pair_edge_a: np.ndarray  # (P,) int64
+    prev_pair_edge_b: np.ndarray  # (P,) int64
+    prev_pair_shear: np.ndarray  # (P, 3)
+    prev_pair_normal: np.ndarray  # (P, 3)
+    prev_pair_normal_force: np.ndarray  # (P,)
+    prev_pair_overlap: np.ndarray  # (P,)
+    prev_pair_key: np.ndarray  # (P,) int64 sorted keys a nb + b of the previous pairs
+    prev_pair_index: np.ndarray  # (P,) int64 the previous pair of each sorted key
+    prev_pair_kept: np.ndarray  # (P,) bool the previous pair was found again
+    energy_scale: np.ndarray  # (1,) [J] largest energy scale recorded so far (divergence check)
+    lost_block: np.ndarray  # (1,) int64 block that diverged or left the extent, -1 none
 
 
 class Records(NamedTuple):
@@ -156,13 +242,13 @@ class Records(NamedTuple):
 def new_records(count: int, blocks: int, driven: int = 0) -> Records:
     """Zeroed record arrays for ``count`` frames, ``blocks`` blocks of which ``driven`` driven."""
     return Records(
-        np.zeros(count),
-        np.zeros((count, blocks, 3)),
-        np.zeros((count, blocks, 4)),
-        np.zeros((count, blocks, 3)),
-        np.zeros((count, blocks, 3)),
-        np.zeros((count, ENERGY_COUNT)),
-        np.zeros((count, 4), dtype=np.int64),
-        np.zeros((count, 3)),
-        np.zeros((count, driven, 3)),
+        time=np.zeros(count),
+        position=np.zeros((count, blocks, 3)),
+        quaternion=np.zeros((count, blocks, 4)),
+        velocity=np.zeros((count, blocks, 3)),
+        omega=np.zeros((count, blocks, 3)),
+        energy=np.zeros((count, ENERGY_COUNT)),
+        counts=np.zeros((count, 4), dtype=np.int64),
+        reaction=np.zeros((count, 3)),
+        driven_reaction=np.zeros((count, driven, 3)),
     )

@@ -1,0 +1,272 @@
+"""Collapse scenarios: tumbling blocks, random piles, bond-failure cascades, overturning walls.
+
+Each builder returns a :class:`Scenario` (model, duration, record interval); ``short=True`` gives
+the quick version run by the tests, the default the full version run by
+``python benchmarks/bench_collapse.py``. :func:`evaluate` runs one and measures what issue-level
+acceptance needs: runtime, divergence, the largest interpenetration between two blocks computed
+independently of the engine (:mod:`rockdem.diagnostics`), and the largest energy creation
+max(KE + PE - initial - work) as a fraction of the run's energy scale.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import xarray as xr
+
+from rockdem.case import parse_case
+from rockdem.diagnostics import max_interpenetration
+from rockdem.geometry import box
+from rockdem.kernels.rotation import axis_angle_matrix
+from rockdem.loading import apply_earthquake, resolve_record
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, Model, ModelBuilder
+from rockdem.records import read_record
+from rockdem.simulate import simulate
+from rockdem.specimens import add_foundation, parapet, stacked_blocks
+
+ELCENTRO = "RSN6_IMPVALL.I_I-ELC180.AT2"
+
+
+@dataclass
+class Scenario:
+    """A model to run and how long.
+
+    Attributes:
+        name: short identifier.
+        model: the finalized model.
+        duration: simulated time [s].
+        record_interval: [s].
+        note: what it exercises.
+        checks: extra named checks, each a function of the result returning a float.
+    """
+
+    name: str
+    model: Model
+    duration: float
+    record_interval: float
+    note: str
+    checks: dict[str, Callable[[xr.Dataset], float]] = field(default_factory=dict)
+
+
+def _mat(kn: float = 6e9, friction: float = 35.0, **kw: float) -> JointMaterial:
+    return JointMaterial(kn=kn, friction_angle=friction, **kw)
+
+
+def _lowest_z(model: Model, ds: xr.Dataset, name: str) -> float:
+    """Lowest vertex height of block ``name`` at the last frame [m]."""
+    from rockdem.kernels.rotation import quats_to_matrices
+
+    b = model.block_id(name)
+    m = model.arrays
+    v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]]
+    r = quats_to_matrices(ds.block_quaternion.values[-1, b])
+    return float(np.min((v @ r.T + ds.block_position.values[-1, b])[:, 2]))
+
+
+def edge_on_wall(short: bool = False) -> Scenario:
+    """A 0.3 m cube turned 45 deg about z and 45 deg about y, dropped from 20 mm with its lowest edge
+    across the top of a free 0.1 m thick wall; it lands on the edge, tips and falls."""
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = _mat()
+    add_foundation(b, 3.0)
+    b.add_box(0.1, 1.0, 0.6, density=2000, name="wall")
+    cube = box(0.3, 0.3, 0.3, name="cube")
+    r = axis_angle_matrix(np.array([0, 0, 1.0]), math.radians(45)) @ axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(45))
+    cube = cube.transformed(r, np.zeros(3))
+    cube = cube.transformed(np.eye(3), [0.01, 0.0, 0.6 + 0.02 - cube.vertices[:, 2].min()])
+    b.add_block(cube, density=2000, name="cube")
+    return Scenario("edge_on_wall", b.finalize(), 0.35 if short else 1.5, 0.002,
+                    "edge landing across a thin wall top (non-conformal, smaller face)")
+
+
+def ridge_to_ridge(short: bool = False, *, gap: float = 0.0079, speed: float = 0.0) -> Scenario:
+    """Two 0.4 m boxes whose ridges cross at right angles, ``gap`` apart, no gravity; the upper one
+    moves down at ``speed`` [m/s] (0: they must stay at rest, no force may act across the gap)."""
+    b = ModelBuilder(points=(2, 2), gravity=(0.0, 0.0, 0.0))
+    b.default_material = _mat(friction=30.0)
+    s = 0.4
+    half_diag = s / math.sqrt(2.0)
+    low = box(s, s, s, name="low").transformed(axis_angle_matrix(np.array([1.0, 0, 0]), math.radians(45)), [0, 0, -half_diag])
+    up = box(s, s, s, name="up").transformed(axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(45)), [0, 0, half_diag + gap])
+    b.add_block(low, density=2000, name="low", driven=True)
+    b.add_block(up, density=2000, name="up", velocity=(0.0, 0.0, -speed))
+    dur = 0.05 if speed == 0 else (gap / speed + 0.05 if short else gap / speed + 0.2)
+    return Scenario("ridge_to_ridge" if speed == 0 else "ridge_impact", b.finalize(), dur, 0.0005,
+                    "crossing edges: no force across a gap; edge-edge impact")
+
+
+def random_pile(short: bool = False, *, count: int = 40, seed: int = 7) -> Scenario:
+    """``count`` boxes of random sizes (0.08-0.3 m) and orientations dropped onto the ground from a
+    loose column; MP + SP damping brings the pile to rest."""
+    n = 12 if short else count
+    rng = np.random.default_rng(seed)
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = _mat(kn=2e9, friction=30.0)
+    add_foundation(b, 4.0)
+    spacing = 0.45
+    per_layer = 9
+    for k in range(n):
+        dims = rng.uniform(0.08, 0.3, size=3)
+        q = rng.normal(size=4)
+        q /= np.linalg.norm(q)
+        from rockdem.kernels.rotation import quats_to_matrices
+
+        r = quats_to_matrices(q)
+        layer, slot = divmod(k, per_layer)
+        cx, cy = (slot % 3 - 1) * spacing + rng.uniform(-0.05, 0.05), (slot // 3 - 1) * spacing + rng.uniform(-0.05, 0.05)
+        poly = box(*dims, name=f"box{k}").transformed(r, [cx, cy, 0.3 + layer * spacing])
+        b.add_block(poly, density=2000, name=f"box{k}")
+    return Scenario("random_pile", b.finalize(damping=Damping(alpha=2.0, beta=2e-4)), 1.5 if short else 4.0, 0.005,
+                    f"{n} random boxes dropped on the ground")
+
+
+def parapet_earthquake(short: bool = False, *, scale: float = 3.0, weak: bool = True) -> Scenario:
+    """A brick parapet 0.23 x 1.2 x 1.0 m (running bond, 0.2 x 0.083 m bricks) under El Centro x
+    ``scale``: weak joints (c = ft = 0.1 MPa) or strong joints on an unbonded base."""
+    b = ModelBuilder()
+    joint = JointMaterial(kn=1.8e9 / 0.0833, friction_angle=31.0, cohesion=1e5 if weak else 1e6, tension=1e5 if weak else 1e6)
+    base = joint if weak else JointMaterial(kn=1.8e9 / 0.0833, friction_angle=31.0)
+    parapet(b, thickness=0.23, height=1.0, length=1.2, brick=(0.2, 1.0 / 12), material=joint, base_material=base, base_reduction=0.0)
+    gm = read_record(resolve_record(ELCENTRO))
+    dur = 3.0 if short else 8.0
+    apply_earthquake(b, gm, scale=scale, window=(0.0, dur), baseline=True)
+    return Scenario(f"parapet_x{scale:g}_{'weak' if weak else 'strong'}", b.finalize(), dur, 0.01,
+                    "discretised parapet overturning under a strong record")
+
+
+def cascade_wall(short: bool = False) -> Scenario:
+    """The weakly bonded 0.19 x 2 m discretised wall of the Table 1 / Fig. 8 studies
+    (c = ft = 0.1 MPa, kn = 1e10 Pa/m), free rocking without damping."""
+    from rockdem.reproduce.table1 import wall_case
+
+    data = wall_case(0.19, 2.0, 1e10, joint={"cohesion": 1e5, "tension": 1e5, "friction_angle_deg": 16.7})
+    data["run"]["duration"] = 3.0 if short else 6.0
+    case = parse_case(data)
+    return Scenario("cascade_wall", case.model, case.run.duration, 0.005, "bond-failure cascade at the impacts")
+
+
+def drum_column(short: bool = False, *, scale: float = 2.0) -> Scenario:
+    """Four 0.4 x 0.4 x 0.5 m drums (2 x 2 points, mu = 0.7) under El Centro x ``scale``."""
+    b = ModelBuilder(points=(2, 2))
+    mat = JointMaterial.from_modulus(1.8e9, 0.5, friction_angle=35.0)
+    b.default_material = mat
+    stacked_blocks(b, width=0.4, length=0.4, heights=[0.5] * 4, density=2400, material=mat)
+    gm = read_record(resolve_record(ELCENTRO))
+    dur = 4.0 if short else 12.0
+    apply_earthquake(b, gm, scale=scale, window=(0.0, dur), baseline=True)
+    return Scenario(f"drum_column_x{scale:g}", b.finalize(), dur, 0.005, "drums sliding and rocking on each other")
+
+
+def topple_near_edge(short: bool = False) -> Scenario:
+    """A 0.25 x 1.25 m block released past its instability angle topples towards the edge of a
+    2.5 m foundation and lands with its top near that edge."""
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial.from_modulus(1.8e9, 1.25, friction_angle=35.0)
+    add_foundation(b, 2.5)
+    b.add_box(0.25, 1.0, 1.25, density=1800, name="block", base_center=(0.0, 0.0, 0.0))
+    b.tilt("block", 1.15)
+    return Scenario("topple_near_edge", b.finalize(), 1.2 if short else 2.5, 0.002, "toppled block landing near an edge")
+
+
+SCENARIOS: dict[str, Callable[..., Scenario]] = {
+    "edge_on_wall": edge_on_wall,
+    "ridge_to_ridge": ridge_to_ridge,
+    "ridge_impact": lambda short=False: ridge_to_ridge(short, gap=0.002, speed=0.2),
+    "random_pile": random_pile,
+    "parapet_x3_weak": lambda short=False: parapet_earthquake(short, scale=3.0, weak=True),
+    "parapet_x5_strong": lambda short=False: parapet_earthquake(short, scale=5.0, weak=False),
+    "cascade_wall": cascade_wall,
+    "drum_column_x2": drum_column,
+    "topple_near_edge": topple_near_edge,
+}
+
+
+@dataclass
+class Outcome:
+    """Measured figures of one scenario run."""
+
+    name: str
+    runtime_s: float
+    steps: int
+    simulated_s: float
+    diverged: bool
+    overlap_m: float
+    overlap_relative: float
+    overlap_blocks: tuple[str, str]
+    energy_created: float
+    energy_scale: float
+    balance_error: float
+    final_kinetic: float
+    extra: dict[str, float]
+
+    def line(self) -> str:
+        return (
+            f"{self.name:20s} {self.runtime_s:8.2f} s {self.steps:9d} steps  {self.simulated_s:6.2f}/{'DIV' if self.diverged else 'ok '} "
+            f" overlap {self.overlap_m * 1e3:7.3f} mm ({100 * self.overlap_relative:5.2f} %)"
+            f"  E created {100 * self.energy_created / max(self.energy_scale, 1e-300):6.3f} %  balance {100 * self.balance_error:6.3f} %"
+            f"  KE_end {self.final_kinetic:.3g} J"
+        )
+
+
+def energy_creation(ds: xr.Dataset) -> tuple[float, float]:
+    """(max over time of KE + PE - initial - work [J], the energy scale [J]).
+
+    The scale is the largest of (kinetic + elastic + |potential| + dissipated + |work|) over the
+    run, as for ``energy_balance_error_relative``."""
+    e = ds.energy_kinetic.values + ds.energy_potential.values
+    work = ds.work_driven.values + ds.work_body.values
+    created = float(np.max(e - e[0] - (work - work[0])))
+    parts = [np.abs(ds[n].values) for n in ds.data_vars if str(n).startswith(("energy_", "work_")) and "balance" not in str(n)]
+    return created, float(np.max(np.sum(parts, axis=0)))
+
+
+def evaluate(sc: Scenario, *, overlap_every: int = 1) -> tuple[Outcome, xr.Dataset]:
+    """Run a scenario and measure it."""
+    t0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        ds = simulate(sc.model, sc.duration, record_interval=sc.record_interval, progress=False)
+    runtime = time.perf_counter() - t0
+    pen = max_interpenetration(ds, frames=slice(None, None, overlap_every))
+    created, scale = energy_creation(ds)
+    err = float(np.max(np.abs(ds.energy_balance_error_relative.values))) if ds.sizes["time"] else float("nan")
+    extra = {k: f(ds) for k, f in sc.checks.items()}
+    out = Outcome(
+        sc.name, runtime, int(ds.attrs["steps"]), float(ds.time.values[-1]) if ds.sizes["time"] else 0.0,
+        bool(ds.attrs.get("diverged", 0)), pen.depth, pen.relative, pen.blocks, created, scale, err,
+        float(ds.energy_kinetic.values[-1]) if ds.sizes["time"] else float("nan"), extra,
+    )
+    return out, ds
+
+
+def run_all(names: list[str] | None = None, *, short: bool = False) -> list[Outcome]:
+    """Run the named scenarios (default all) and print one line each."""
+    outs = []
+    for name in names or list(SCENARIOS):
+        try:
+            sc = SCENARIOS[name](short=short)
+            out, _ = evaluate(sc, overlap_every=1 if short else 2)
+        except Exception as exc:  # a scenario that cannot run is reported, not fatal
+            print(f"{name:20s} FAILED: {type(exc).__name__}: {exc}", flush=True)
+            continue
+        print(out.line(), flush=True)
+        outs.append(out)
+    return outs
+
+
+def _print_header() -> None:
+    print(f"{'scenario':20s} {'runtime':>10s} {'steps':>15s}  simulated  max overlap (of thinner block)  energy created / scale")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    _print_header()
+    run_all(args or None, short="--short" in sys.argv)

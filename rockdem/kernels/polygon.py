@@ -1,0 +1,125 @@
+"""Small planar and segment geometry for the contact kernels (allocation-free, Numba).
+
+Polygons are (n, 2) counter-clockwise vertex buffers with an explicit count; half-planes are
+(lu, lw, lo): lu x + lw y <= lo inside.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def clip_halfplane(src: np.ndarray, n: int, lu: float, lw: float, lo: float, dst: np.ndarray) -> int:
+    """Sutherland-Hodgman step: the part of polygon ``src[:n]`` inside lu x + lw y <= lo, written to
+    ``dst``; returns its vertex count (0 when nothing is left)."""
+    out = 0
+    if n == 0:
+        return 0
+    px, py = src[n - 1, 0], src[n - 1, 1]
+    dp = lu * px + lw * py - lo
+    for i in range(n):
+        cx, cy = src[i, 0], src[i, 1]
+        dc = lu * cx + lw * cy - lo
+        if dc <= 0.0:
+            if dp > 0.0:
+                t = dp / (dp - dc)
+                dst[out, 0] = px + t * (cx - px)
+                dst[out, 1] = py + t * (cy - py)
+                out += 1
+            dst[out, 0] = cx
+            dst[out, 1] = cy
+            out += 1
+        elif dp <= 0.0:
+            t = dp / (dp - dc)
+            dst[out, 0] = px + t * (cx - px)
+            dst[out, 1] = py + t * (cy - py)
+            out += 1
+        px, py, dp = cx, cy, dc
+    return out
+
+
+@njit(cache=True, inline="always")
+def polygon_area(poly: np.ndarray, n: int) -> float:
+    """Area of polygon ``poly[:n]`` (positive when counter-clockwise) [m^2]."""
+    a = 0.0
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        a += poly[i, 0] * poly[j, 1] - poly[j, 0] * poly[i, 1]
+    return 0.5 * a
+
+
+@njit(cache=True, inline="always")
+def nearest_on_polygon(poly: np.ndarray, n: int, x: float, y: float) -> tuple[float, float]:
+    """Point of the boundary of polygon ``poly[:n]`` nearest to (x, y)."""
+    best = np.inf
+    bx, by = x, y
+    for i in range(n):
+        j = i + 1 if i + 1 < n else 0
+        ax, ay = poly[i, 0], poly[i, 1]
+        ex, ey = poly[j, 0] - ax, poly[j, 1] - ay
+        ee = ex * ex + ey * ey
+        t = ((x - ax) * ex + (y - ay) * ey) / ee if ee > 0.0 else 0.0
+        t = min(max(t, 0.0), 1.0)
+        qx, qy = ax + t * ex, ay + t * ey
+        d = (qx - x) * (qx - x) + (qy - y) * (qy - y)
+        if d < best:
+            best, bx, by = d, qx, qy
+    return bx, by
+
+
+@njit(cache=True, inline="always")
+def deepest_vertex(
+    poly: np.ndarray, n: int, h0: float, hu: float, hw: float, x: float, y: float, tie: float
+) -> tuple[float, float]:
+    """Vertex of polygon ``poly[:n]`` where the affine height h0 + hu u + hw w is lowest (the
+    deepest overlap); vertices within ``tie`` [m] of the lowest count as equal and the one nearest
+    to (x, y) is taken."""
+    low = np.inf
+    for i in range(n):
+        low = min(low, h0 + hu * poly[i, 0] + hw * poly[i, 1])
+    best = np.inf
+    bx, by = x, y
+    for i in range(n):
+        if h0 + hu * poly[i, 0] + hw * poly[i, 1] <= low + tie:
+            d = (poly[i, 0] - x) ** 2 + (poly[i, 1] - y) ** 2
+            if d < best:
+                best, bx, by = d, poly[i, 0], poly[i, 1]
+    return bx, by
+
+
+@njit(cache=True, inline="always")
+def segment_closest(
+    p0: float, p1: float, p2: float, d0: float, d1: float, d2: float,
+    q0: float, q1: float, q2: float, e0: float, e1: float, e2: float,
+) -> tuple[float, float]:
+    """Parameters (s, t) in [0, 1] of the closest points p + s d and q + t e of two segments
+    (Ericson, Real-Time Collision Detection, 5.1.9)."""
+    r0, r1, r2 = p0 - q0, p1 - q1, p2 - q2
+    a = d0 * d0 + d1 * d1 + d2 * d2
+    e = e0 * e0 + e1 * e1 + e2 * e2
+    f = e0 * r0 + e1 * r1 + e2 * r2
+    c = d0 * r0 + d1 * r1 + d2 * r2
+    b = d0 * e0 + d1 * e1 + d2 * e2
+    den = a * e - b * b
+    s = min(max((b * f - c * e) / den, 0.0), 1.0) if den > 1e-300 else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        t = 0.0
+        s = min(max(-c / a, 0.0), 1.0)
+    elif t > 1.0:
+        t = 1.0
+        s = min(max((b - c) / a, 0.0), 1.0)
+    return s, t
+
+
+@njit(cache=True, inline="always")
+def normalize3(x: float, y: float, z: float) -> tuple[float, float, float, float]:
+    """Unit vector and the length of (x, y, z)."""
+    n = math.sqrt(x * x + y * y + z * z)
+    if n == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    return x / n, y / n, z / n, n
