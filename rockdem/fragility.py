@@ -212,7 +212,7 @@ def _fragility_cli(args: argparse.Namespace) -> int:
 def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """Add ``fragility``."""
     p = subparsers.add_parser("fragility", help="IDA over records and PGA levels, with a lognormal fragility fit")
-    p.add_argument("records", nargs="+", help="record names (shared ground-motion folder) or files")
+    p.add_argument("records", nargs="+", help="shipped record names (`rockdem records`), files, or file names in $ROCKDEM_DATA")
     p.add_argument("--base", default="free-rocking", help="base case (its block; the loading is replaced)")
     p.add_argument("--pga", nargs=3, default=(0.05, 1.0, 10), metavar=("LOW", "HIGH", "N"), help="PGA levels [g]")
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]")
