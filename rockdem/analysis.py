@@ -3,7 +3,7 @@
 Functions on plain NumPy arrays come first (usable on a measured history read from a CSV), then
 thin adapters for a rockdem result (an ``xarray.Dataset`` with coordinate ``time`` [s], variables
 ``rocking_angle (time, block)`` [rad], ``block_position (time, block, xyz)`` [m], ``block_free
-(block)``). References are to Galvez et al. 2022 (the founding paper, "§") and DESIGN §4.
+(block)``). References are to Galvez et al. 2022 (the founding paper, "§", "Eq.").
 
 Definitions:
     * half-cycle peak: a local maximum of |theta| between two impacts (zero crossings or touches);
@@ -107,7 +107,7 @@ def _history(t: ArrayLike, x: ArrayLike, name: str = "x") -> tuple[NDArray[np.fl
 def half_cycle_peaks(
     t: ArrayLike, theta: ArrayLike, *, min_prominence: float | None = None, refine: bool = True
 ) -> HalfCyclePeaks:
-    """Peak |theta| of every half cycle (DESIGN §4).
+    """Peak |theta| of every half cycle (the peaks of paper Eq. 6 and Figs. 6, 8).
 
     A peak is a local maximum of |theta| whose prominence exceeds ``min_prominence``, so both
     two-sided rocking (sign changes) and one-sided rocking (touches of zero) are handled. A history
@@ -219,7 +219,7 @@ def wme(
     cut_at_rest: bool = True,
     rest_tol: float | None = None,
 ) -> float:
-    """Weighted mean error between a reference and a simulated history (DESIGN §4, paper §3.1).
+    """Weighted mean error between a reference and a simulated history (paper §3.1).
 
     WME = sum_i |x_i - y_i| |x_i| / sum_i x_i^2, with x the reference at its own samples and y the
     simulation linearly interpolated there. Amplitude-weighted; 0 for a perfect match; invariant to
