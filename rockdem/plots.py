@@ -320,7 +320,8 @@ def plot_bouncing(result: Result, *, block: int | str | None = None, gap: float 
     bo = bouncing(t, low, z_contact=low[0] + base[:, 2], tol=gap)
     fig = Figure(figsize=(_WIDTH, 3.4))
     ax = fig.subplots()
-    ax.plot(t, uz * 1e3, color="C0", label="centroid u_z (relative to the ground)")
+    rel = " (relative to the ground)" if ds.block_displacement.attrs.get("reference") == "ground" else ""
+    ax.plot(t, uz * 1e3, color="C0", label=f"centroid u_z{rel}")
     for k, (t0, dur) in enumerate(zip(bo.start, bo.duration)):
         ax.axvspan(t0, t0 + dur, color="C3", alpha=0.25, lw=0, label="airborne" if k == 0 else None)
     ax.set_xlabel("time [s]")
@@ -587,12 +588,17 @@ def _not_applicable(kind: str, items: Sequence[xr.Dataset], measured: object) ->
     if kind == "capacity" and not all(is_pushover(ds) for ds in items):
         return "not a pushover result"
     if kind == "restitution" and not is_free_rocking(first):
-        return "not a free-rocking run (e_a, Eq. 6, measures the decay of rocking released from rest)"
+        return "not a free-rocking run; e_a (Eq. 6) measures the decay of rocking released from rest"
     if kind == "bouncing" and is_pushover(first):
         return "a quasi-static pushover has no impacts"
     if kind == "comparison" and len(items) < 2 and measured is None:
         return "one result and no --measured history: nothing to compare"
     return ""
+
+
+def _file_label(path: Path) -> str:
+    """A result's name from its file: the folder for the usual ``<folder>/result.nc``."""
+    return path.resolve().parent.name if path.stem == "result" else path.stem
 
 
 def _plot(args: argparse.Namespace) -> int:
@@ -602,18 +608,20 @@ def _plot(args: argparse.Namespace) -> int:
     if len(args.results) > 1 and not set(kinds) & multi:
         raise ValueError(f"--kind {args.kind} draws one result; give one RESULT or use --kind comparison/capacity")
     loaded = [load_result(r) for r in args.results]
+    for ds, r in zip(loaded, args.results):
+        ds.attrs.setdefault("name", _file_label(Path(r)))
     written, skipped = [], []
     for kind in kinds:
         why = _not_applicable(kind, loaded if kind in multi else loaded[:1], args.measured)
         if why and args.kind == "all":
-            skipped.append(f"{kind} ({why})")
+            skipped.append(f"{kind}: {why}")
             continue
         if why and kind == "capacity":
             raise ValueError(f"--kind capacity: {why}; capacity curves apply to pushover results")
         func = PLOTS[kind]
         kw: dict[str, object] = {}
         if kind in multi:
-            kw["labels"] = args.labels or [Path(r).stem for r in args.results]
+            kw["labels"] = args.labels or [_file_label(Path(r)) for r in args.results]
             target: object = loaded
         else:
             target = loaded[0]

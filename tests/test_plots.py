@@ -66,14 +66,14 @@ def test_plot_all_writes_the_plots_that_apply_and_says_which_it_skipped(result_f
     for kind in PLOTS:
         p = result_files["example"].with_name(f"example_{kind}.pdf")
         if kind in ("capacity", "comparison"):
-            assert not p.exists() and f"skipped {kind} (" in out
+            assert not p.exists() and f"skipped {kind}: " in out
         else:
             assert p.read_bytes()[:5] == b"%PDF-"
     # a pushover: capacity yes, restitution and bouncing (free-rocking and impact measures) no
     assert main(["plot", str(result_files["pushover"]), "--kind", "all"]) == 0
     out = capsys.readouterr().out
     assert result_files["pushover"].with_name("pushover_capacity.png").exists()
-    assert "skipped restitution (" in out and "skipped bouncing (" in out
+    assert "skipped restitution: " in out and "skipped bouncing: " in out
 
 
 def _rod_pushover(b: float, h: float, z: float, duration: float):
