@@ -608,6 +608,10 @@ DATA_ENV = "ROCKDEM_DATA"
 _PEER = "PEER NGA-West2 terms of use apply (a PEER database product)"
 _EEUQ = ("NHERI-SimCenter/EE-UQ @ 3c5339f74b86998fc68af0df7cf1b4e2ce7b1cf7; the repository's BSD-2-Clause "
          "licence covers its source code only, not these data files")
+_IRPINIA_SOURCE = ("vacalderon/GroundmotionSelection @ 4575a07afb90e2a254291c19a0518df52a87846d (Mainshocks/, "
+                   "deleted in a later commit)")
+_IRPINIA_LICENCE = (f"PROVISIONAL: repository without licence; {_PEER}; Italian recording, redistribution terms "
+                    "not verified; header dt printed to 4 decimals only")
 
 
 @dataclass(frozen=True)
@@ -645,57 +649,100 @@ class ShippedRecord:
 
 SHIPPED_RECORDS: tuple[ShippedRecord, ...] = (
     ShippedRecord(
-        "elcentro-rsn6", "RSN6_IMPVALL.I_I-ELC180.AT2", "Imperial Valley-02", "1940-05-19",
-        "El Centro Array #9", "180 (N-S)", "g",
-        "ab219fe7bc8060fb5dba31669b5c29a782435bef113eda51ab81b8f6ff05824d",
-        _EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
-        f"{_PEER}; a US federal record (USGS station 117): public domain inferred, not verified",
-        paper_name="El Centro 1940 NS"),
+        name="elcentro-rsn6",
+        file="RSN6_IMPVALL.I_I-ELC180.AT2",
+        event="Imperial Valley-02",
+        date="1940-05-19",
+        station="El Centro Array #9",
+        component="180 (N-S)",
+        units="g",
+        sha256="ab219fe7bc8060fb5dba31669b5c29a782435bef113eda51ab81b8f6ff05824d",
+        source=_EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
+        licence=_PEER + "; a US federal record (USGS station 117): public domain inferred, not verified",
+        paper_name="El Centro 1940 NS",
+    ),
     ShippedRecord(
-        "elcentro-peknold", "elCentro.AT2", "Imperial Valley (El Centro)", "1940-05-19",
-        "El Centro", "N-S (Peknold version)", "g",
-        "e096f0458ae7565ac8e9fac80eda018e4715a357ea4c14504ce1cfa6556c53a6",
-        _EEUQ + " (Examples/eeuq-0001/src, last changed in 30457c6dc757084137075e893452b31ff4ba942b)",
-        "processing history of the Peknold version undocumented; licence as the EE-UQ note",
-        paper_name="El Centro 1940 NS"),
+        name="elcentro-peknold",
+        file="elCentro.AT2",
+        event="Imperial Valley (El Centro)",
+        date="1940-05-19",
+        station="El Centro",
+        component="N-S (Peknold version)",
+        units="g",
+        sha256="e096f0458ae7565ac8e9fac80eda018e4715a357ea4c14504ce1cfa6556c53a6",
+        source=_EEUQ + " (Examples/eeuq-0001/src, last changed in 30457c6dc757084137075e893452b31ff4ba942b)",
+        licence="processing history of the Peknold version undocumented; licence as the EE-UQ note",
+        paper_name="El Centro 1940 NS",
+    ),
     ShippedRecord(
-        "pacoima", "RSN77_SFERN_PUL164.AT2", "San Fernando", "1971-02-09",
-        "Pacoima Dam (upper left abut.)", "164", "g",
-        "ea1186e852208172b90d20416fb18e9a9683881ed49fff92299982d73f131b16",
-        _EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
-        f"{_PEER}; a California state record (CDMG station 279): public domain not verified",
-        paper_name="Pacoima Dam 1971"),
+        name="pacoima",
+        file="RSN77_SFERN_PUL164.AT2",
+        event="San Fernando",
+        date="1971-02-09",
+        station="Pacoima Dam (upper left abut.)",
+        component="164",
+        units="g",
+        sha256="ea1186e852208172b90d20416fb18e9a9683881ed49fff92299982d73f131b16",
+        source=_EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
+        licence=_PEER + "; a California state record (CDMG station 279): public domain not verified",
+        paper_name="Pacoima Dam 1971",
+    ),
     ShippedRecord(
-        "nahanni", "Nahanni_1985_NS1-280.csv", "Nahanni, Canada", "1985", "Site 1", "280", "g",
-        "0775c99a96c957a87bfded82e89a5da71b8cc116f98fc11b35917559f142c690",
-        "pySLAMMER/pySLAMMER @ dd8cfad35ab4b0a7258ff2e1b7389af0ad9d0325 "
-        "(src/pyslammer/sample_ground_motions, last changed in 4c622266be28eca4ab05f89cf9ff0cd25244b5a1)",
-        "repository GPL-3.0; recorded by the Geological Survey of Canada, whose terms were not verified",
-        paper_name="Nahanni 1985"),
+        name="nahanni",
+        file="Nahanni_1985_NS1-280.csv",
+        event="Nahanni, Canada",
+        date="1985",
+        station="Site 1",
+        component="280",
+        units="g",
+        sha256="0775c99a96c957a87bfded82e89a5da71b8cc116f98fc11b35917559f142c690",
+        source=("pySLAMMER/pySLAMMER @ dd8cfad35ab4b0a7258ff2e1b7389af0ad9d0325 (src/pyslammer/sample_ground_motions, "
+                "last changed in 4c622266be28eca4ab05f89cf9ff0cd25244b5a1)"),
+        licence="repository GPL-3.0; recorded by the Geological Survey of Canada, whose terms were not verified",
+        paper_name="Nahanni 1985",
+    ),
     ShippedRecord(
-        "bagnoli", "RSN285_ITALY_A-BAG270.AT2", "Irpinia Italy-01", "1980-11-23", "Bagnoli Irpinio",
-        "270 (W-E)", "g", "42dee7d3b555fcbf2f0b0a66379bc8b2f4d88ba5fe1b3cebd344bf2f696bdb63",
-        "vacalderon/GroundmotionSelection @ 4575a07afb90e2a254291c19a0518df52a87846d (Mainshocks/, "
-        "deleted in a later commit)",
-        f"PROVISIONAL: repository without licence; {_PEER}; Italian recording, redistribution terms "
-        "not verified; header dt printed to 4 decimals only",
-        provisional=True, paper_name="BagnirWE"),
+        name="bagnoli",
+        file="RSN285_ITALY_A-BAG270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Bagnoli Irpinio",
+        component="270 (W-E)",
+        units="g",
+        sha256="42dee7d3b555fcbf2f0b0a66379bc8b2f4d88ba5fe1b3cebd344bf2f696bdb63",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="BagnirWE",
+    ),
     ShippedRecord(
-        "calitri", "RSN289_ITALY_A-CTR270.AT2", "Irpinia Italy-01", "1980-11-23", "Calitri",
-        "270 (W-E)", "g", "2ed09f077491311be312b67099100412865653d4e9212cd669e6a566dd2577a1",
-        "vacalderon/GroundmotionSelection @ 4575a07afb90e2a254291c19a0518df52a87846d (Mainshocks/, "
-        "deleted in a later commit)",
-        f"PROVISIONAL: repository without licence; {_PEER}; Italian recording, redistribution terms "
-        "not verified; header dt printed to 4 decimals only",
-        provisional=True, paper_name="CalitWE"),
+        name="calitri",
+        file="RSN289_ITALY_A-CTR270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Calitri",
+        component="270 (W-E)",
+        units="g",
+        sha256="2ed09f077491311be312b67099100412865653d4e9212cd669e6a566dd2577a1",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="CalitWE",
+    ),
     ShippedRecord(
-        "sturno", "RSN292_ITALY_A-STU270.AT2", "Irpinia Italy-01", "1980-11-23", "Sturno (STN)",
-        "270 (W-E)", "g", "f5c3bd51b15a75b6dfc902ea40e49fe0b7f733e08eb270b20020eb2224c478a0",
-        "vacalderon/GroundmotionSelection @ 4575a07afb90e2a254291c19a0518df52a87846d (Mainshocks/, "
-        "deleted in a later commit)",
-        f"PROVISIONAL: repository without licence; {_PEER}; Italian recording, redistribution terms "
-        "not verified; header dt printed to 4 decimals only",
-        provisional=True, paper_name="SturWE"),
+        name="sturno",
+        file="RSN292_ITALY_A-STU270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Sturno (STN)",
+        component="270 (W-E)",
+        units="g",
+        sha256="f5c3bd51b15a75b6dfc902ea40e49fe0b7f733e08eb270b20020eb2224c478a0",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="SturWE",
+    ),
 )
 """The records shipped in ``rockdem/data/ground-motions`` (details in that folder's SOURCES.md)."""
 
