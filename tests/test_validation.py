@@ -241,3 +241,7 @@ def test_peak_ground_acceleration_is_checked_for_plausibility(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         parse_case(data)
+    del data["loading"]["pga_g"]
+    data["loading"]["scale"] = 1e4  # the record's 0.1 g peak becomes ~1000 g (after baseline correction)
+    with pytest.raises(ValueError, match=r"scaled record's peak ground acceleration \[g\] \(see scale\) = \d+\.?\d* is not plausible"):
+        parse_case(data)
