@@ -1,7 +1,7 @@
 """Damping advisor: which damping to use for a rocking DEM model, and with which values.
 
-Implements the guidance of Galvez et al. 2022 (the founding paper, "§" below) as summarised in
-DESIGN §3, for a block of width B (rocking direction), height H and length L:
+Implements the guidance of Galvez et al. 2022 (the founding paper, "§" below) for a block of width
+B (rocking direction), height H and length L:
 
 * m_b = rho B H, k_j = E B / H, k_s = E B^2 / (2 H) per metre of length (Eq. 2);
 * omega_c, omega_e, omega_r (Eq. 1, 3; omega_r from Eq. 1 with Eq. 2: the paper's Eq. 3 prints
@@ -14,10 +14,13 @@ DESIGN §3, for a block of width B (rocking direction), height H and length L:
 * kn = E / l with l = H / n_b, ks = kn / (2 (1 + nu)) (§3);
 * eta = atan(B/H), semi-diagonal R, eta/R with a bouncing warning above 45 deg/m (§3.1);
 * Housner e_eta = 1 - 1.5 sin^2 eta and 0.95 e_eta (§3.2.1);
-* stable timesteps for MP and SP runs and the expected SP/MP cost ratio (DESIGN §2 "Timestep").
+* stable timesteps for MP and SP runs and the expected SP/MP cost ratio (central differences,
+  with Belytschko's reduction for SP damping); only these depend on the length L.
 
 Geometry of the rocking body: the whole element B x H for ``single`` and ``one-sided``; one block
-B x (H / blocks) for ``stacked`` (each block of the stack rocks and impacts its neighbours).
+B x (H / blocks) for ``stacked`` (each block of the stack rocks and impacts its neighbours). More
+than one block implies ``stacked`` unless ``single`` is given: a discretised element that rocks as
+a whole (paper §3.2.2, the discretised parapet of §4.1), whose joints only set kn = E / (H / blocks).
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ __all__ = ["Configuration", "AdviceInput", "Advice", "advise", "impact_frequenci
 BOUNCING_LIMIT_DEG_PER_M = 45.0
 """eta/R above which bouncing was critical with under-damped impacts [deg/m] (§3.1, Fig. 5B)."""
 SAFETY = 0.9
-"""Fraction of the stable step used by the engine (DESIGN §2)."""
+"""Fraction of the stable step used by the engine."""
 
 
 class Configuration(str, enum.Enum):
@@ -57,26 +60,29 @@ class AdviceInput:
     Attributes:
         width: B, block dimension in the rocking direction (wall thickness) [m].
         height: H, total height of the element [m].
-        length: L, dimension along the rocking axis [m].
+        length: L, dimension along the rocking axis [m] (default 1, per metre of wall); only the
+            timestep estimate (omega_max, dt) depends on it, not beta or alpha.
         density: rho [kg/m^3].
         youngs_modulus: E [Pa].
         poisson: nu [-], in (-1, 0.5).
         blocks: n_b, number of blocks over the height [-] (joint spacing l = H / n_b).
-        configuration: single, stacked (needs blocks >= 2) or one-sided.
+        configuration: single, stacked (needs blocks >= 2) or one-sided; default stacked when
+            blocks > 1, else single (``configuration_implied`` is then True).
         damping_ratio: target zeta at the critical frequency [-] (1 = critical).
         points: interface points across the thickness (2 = the corners) [-].
     """
 
     width: float
     height: float
-    length: float
+    length: float = 1.0
     density: float
     youngs_modulus: float
     poisson: float = 0.25
     blocks: int = 1
-    configuration: Configuration = Configuration.SINGLE
+    configuration: Configuration | str | None = None
     damping_ratio: float = 1.0
     points: int = 2
+    configuration_implied: bool = field(default=False, init=False)
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "length", "density", "youngs_modulus", "damping_ratio"):
@@ -89,6 +95,9 @@ class AdviceInput:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise ValueError(f"{name} must be a positive integer, got {v!r}")
+        if self.configuration is None:
+            object.__setattr__(self, "configuration_implied", True)
+            object.__setattr__(self, "configuration", Configuration.STACKED if self.blocks > 1 else Configuration.SINGLE)
         try:
             conf = Configuration(self.configuration)
         except ValueError:
@@ -113,7 +122,7 @@ class Advice:
     """Outputs of the advisor; every number has a unit and a source (see :meth:`rows`)."""
 
     inputs: AdviceInput
-    rocking_height: float = _out("m", "DESIGN §3: H for single/one-sided, H/n_b for stacked", "rocking body height h")
+    rocking_height: float = _out("m", "§2.2: H for single/one-sided, H/n_b for stacked", "rocking body height h")
     mass_per_length: float = _out("kg/m", "Eq. 2: m_b = rho B h", "m_b")
     k_j: float = _out("N/m/m", "Eq. 2: k_j = E B / h", "k_j")
     k_s: float = _out("N/m/m", "Eq. 2: k_s = E B^2 / (2 h)", "k_s")
@@ -132,9 +141,9 @@ class Advice:
     eta_over_r: float = _out("deg/m", "§3.1, Fig. 5B: bouncing critical above 45 deg/m", "eta / R")
     e_eta: float = _out("-", "§3.2.1: e_eta = 1 - 1.5 sin^2 eta", "Housner e_eta")
     e_eta_95: float = _out("-", "§3.2.1: 0.95 e_eta (closer to experiments)", "0.95 e_eta")
-    omega_max: float = _out("rad/s", "DESIGN §2: Gershgorin bound of the sub-contact springs (estimate)", "omega_max")
-    dt_mp: float = _out("s", "DESIGN §2: 0.9 x 2 / omega_max", "dt, MP or no damping")
-    dt_sp: float = _out("s", "DESIGN §2: 0.9 x 2/omega_max x (sqrt(1+xi^2) - xi), xi = beta omega_max / 2", "dt, SP")
+    omega_max: float = _out("rad/s", "Gershgorin bound of the sub-contact springs (estimate; depends on L)", "omega_max")
+    dt_mp: float = _out("s", "central differences: 0.9 x 2 / omega_max", "dt, MP or no damping")
+    dt_sp: float = _out("s", "Belytschko: 0.9 x 2/omega_max x (sqrt(1+xi^2) - xi), xi = beta omega_max / 2", "dt, SP")
     cost_ratio: float = _out("-", "dt_MP / dt_SP", "expected SP/MP cost")
     dt_3dec_mp: float = _out("s", "§3: 0.2 sqrt(m_min / k_max)", "dt 3DEC rule, MP")
     dt_3dec_sp: float = _out("s", "§3 + Belytschko: 3DEC dt x SP reduction", "dt 3DEC rule, SP")
@@ -171,7 +180,7 @@ class Advice:
         i = self.inputs
         head = (
             f"rockdem advise: B = {i.width:g} m, H = {i.height:g} m, L = {i.length:g} m, rho = {i.density:g} kg/m3, "
-            f"E = {i.youngs_modulus / 1e6:g} MPa, nu = {i.poisson:g}, {i.blocks} block(s), {i.configuration.value}, "
+            f"E = {i.youngs_modulus / 1e6:g} MPa, nu = {i.poisson:g}, {i.blocks} block(s), {_configuration_text(i)}, "
             f"zeta = {i.damping_ratio:g}, {i.points} points across"
         )
         lines = [head, ""]
@@ -183,6 +192,14 @@ class Advice:
         if self.warnings:
             lines += ["", "Warnings:"] + [f"  ! {r}" for r in self.warnings]
         return "\n".join(lines)
+
+
+def _configuration_text(i: AdviceInput) -> str:
+    conf = Configuration(i.configuration).value
+    if i.configuration_implied and i.blocks > 1:
+        return (f"{conf} (implied by {i.blocks} blocks; configuration single: a discretised element that "
+                "rocks as a whole)")
+    return conf
 
 
 def impact_frequencies(b: float, h: float, density: float, e: float) -> tuple[float, float, float, float, float, float]:
@@ -239,7 +256,7 @@ def omega_max_bound(
 
 
 def advise(inputs: AdviceInput | None = None, **kwargs: Any) -> Advice:
-    """Damping advice for a rocking block (module docstring; DESIGN §3).
+    """Damping advice for a rocking block (module docstring).
 
     Args:
         inputs: an AdviceInput, or None and its fields as keyword arguments.
@@ -395,7 +412,7 @@ def _run(args: argparse.Namespace) -> int:
     inputs = AdviceInput(
         width=args.width,
         height=args.height,
-        length=args.length,
+        length=1.0 if args.length is None else args.length,
         density=args.density,
         youngs_modulus=e,
         poisson=args.poisson,
@@ -423,7 +440,9 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--width", type=float, required=True, help="B, thickness in the rocking direction [m]")
     p.add_argument("--height", type=float, required=True, help="H, total height [m]")
-    p.add_argument("--length", type=float, required=True, help="L, length along the rocking axis [m]")
+    p.add_argument("--length", type=float, default=None,
+                   help="L, length along the rocking axis [m] (default 1, per metre of wall); only the timestep "
+                        "estimate (omega_max, dt) depends on it, not beta or alpha")
     p.add_argument("--density", type=float, required=True, help="density [kg/m3]")
     emod = p.add_mutually_exclusive_group()
     emod.add_argument("--youngs-modulus", type=float, help="Young's modulus E [Pa]")
@@ -431,7 +450,9 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--poisson", type=float, default=0.25, help="Poisson's ratio [-] (default 0.25)")
     p.add_argument("--blocks", type=int, default=1, help="number of blocks over the height (default 1)")
     p.add_argument(
-        "--configuration", choices=[c.value for c in Configuration], default="single", help="default single"
+        "--configuration", choices=[c.value for c in Configuration], default=None,
+        help="default: stacked when --blocks > 1 (each block rocks, paper §2.2, §4.4), else single; give single "
+             "with --blocks N for a discretised element that rocks as a whole (joints at H/N set kn only)",
     )
     p.add_argument("--damping-ratio", type=float, default=1.0, help="target zeta at omega_crit (default 1, critical)")
     p.add_argument("--points", type=int, default=2, help="interface points across the thickness (default 2)")

@@ -3,7 +3,7 @@
 Functions on plain NumPy arrays come first (usable on a measured history read from a CSV), then
 thin adapters for a rockdem result (an ``xarray.Dataset`` with coordinate ``time`` [s], variables
 ``rocking_angle (time, block)`` [rad], ``block_position (time, block, xyz)`` [m], ``block_free
-(block)``). References are to Galvez et al. 2022 (the founding paper, "§") and DESIGN §4.
+(block)``). References are to Galvez et al. 2022 (the founding paper, "§", "Eq.").
 
 Definitions:
     * half-cycle peak: a local maximum of |theta| between two impacts (zero crossings or touches);
@@ -39,6 +39,7 @@ __all__ = [
     "rocking_onset_time",
     "summarize",
     "lowest_point_height",
+    "result_eta",
     "summarize_result",
 ]
 
@@ -106,7 +107,7 @@ def _history(t: ArrayLike, x: ArrayLike, name: str = "x") -> tuple[NDArray[np.fl
 def half_cycle_peaks(
     t: ArrayLike, theta: ArrayLike, *, min_prominence: float | None = None, refine: bool = True
 ) -> HalfCyclePeaks:
-    """Peak |theta| of every half cycle (DESIGN §4).
+    """Peak |theta| of every half cycle (the peaks of paper Eq. 6 and Figs. 6, 8).
 
     A peak is a local maximum of |theta| whose prominence exceeds ``min_prominence``, so both
     two-sided rocking (sign changes) and one-sided rocking (touches of zero) are handled. A history
@@ -218,7 +219,7 @@ def wme(
     cut_at_rest: bool = True,
     rest_tol: float | None = None,
 ) -> float:
-    """Weighted mean error between a reference and a simulated history (DESIGN §4, paper §3.1).
+    """Weighted mean error between a reference and a simulated history (paper §3.1).
 
     WME = sum_i |x_i - y_i| |x_i| / sum_i x_i^2, with x the reference at its own samples and y the
     simulation linearly interpolated there. Amplitude-weighted; 0 for a perfect match; invariant to
@@ -469,6 +470,22 @@ def lowest_point_height(ds: Any, block: int) -> NDArray[np.float64] | None:
     return zc + np.min(row_z @ v.T, axis=1)
 
 
+def result_eta(ds: Any, block: int) -> float | None:
+    """Instability angle [rad] of a block of a rockdem result, about the pivot it rocks on.
+
+    For an assembly released by a free-rocking tilt (attrs ``tilted_blocks`` > 1): the assembly's
+    angle ``tilt_angle_rad / tilt_fraction``; else ``block_eta[block]`` (the base contact face's
+    edge, so a reduced parapet base counts); None when neither is known.
+    """
+    a = getattr(ds, "attrs", {})
+    if int(a.get("tilted_blocks", 0)) > 1 and float(a.get("tilt_fraction", 0.0)) > 0:
+        return float(a["tilt_angle_rad"]) / float(a["tilt_fraction"])
+    if "block_eta" in ds.variables:
+        eta = float(ds["block_eta"].values[block])
+        return eta if np.isfinite(eta) else None
+    return None
+
+
 def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = None) -> dict[str, Any]:
     """:func:`summarize` for one block of a rockdem result (``xarray.Dataset``).
 
@@ -477,9 +494,8 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
             optional ``block_eta (block)`` [rad] and the geometry used by
             :func:`lowest_point_height` (for bouncing).
         block: block index; default the first free block.
-        eta: slenderness angle [rad]; default: for an assembly released by a free-rocking tilt
-            (attrs ``tilted_blocks`` > 1), the assembly's angle ``tilt_angle_rad / tilt_fraction``;
-            else ``block_eta[block]`` if present, else no e_a and no overturning flag.
+        eta: slenderness angle [rad]; default :func:`result_eta` (the assembly's angle for a
+            released assembly, else ``block_eta[block]``), else no e_a and no overturning flag.
 
     Raises:
         ValueError: missing variables, no free block, or a bad block index.
@@ -495,11 +511,8 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
         block = int(idx[0])
     if not (0 <= block < len(free)):
         raise ValueError(f"block index {block} out of range 0..{len(free) - 1}")
-    a = getattr(ds, "attrs", {})
-    if eta is None and int(a.get("tilted_blocks", 0)) > 1 and float(a.get("tilt_fraction", 0.0)) > 0:
-        eta = float(a["tilt_angle_rad"]) / float(a["tilt_fraction"])
-    if eta is None and "block_eta" in ds.variables:
-        eta = float(ds["block_eta"].values[block])
+    if eta is None:
+        eta = result_eta(ds, block)
     t = np.asarray(ds["time"].values, dtype=float)
     theta = np.asarray(ds["rocking_angle"].values[:, block], dtype=float)
     z = lowest_point_height(ds, block)

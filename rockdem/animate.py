@@ -24,6 +24,7 @@ from matplotlib import colormaps, rc_context
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from .cli import integer_at_least, positive_float, positive_int
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices, rotation_vector
 from .plots import STYLE, Result, load_result, rocking_direction
 
@@ -320,10 +321,16 @@ def _view_arg(text: str) -> str | tuple[float, float]:
 
 
 def _animate(args: argparse.Namespace) -> int:
+    from .vtk_export import read_result_file
+
     out = Path(args.output) if args.output else Path(args.result).with_suffix(".gif")
+    if out.is_dir():
+        raise ValueError(f"-o {out} is a folder; give the animation file (.gif or .mp4)")
+    if out.suffix.lower() not in (".gif", ".mp4"):
+        raise ValueError(f"-o {out}: the suffix must be .gif or .mp4")
     w, h = args.size
     p = animate(
-        args.result,
+        read_result_file(args.result),
         out,
         fps=args.fps,
         view=args.view,
@@ -340,13 +347,13 @@ def _animate(args: argparse.Namespace) -> int:
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``animate`` sub-command."""
     p = subparsers.add_parser("animate", help="animate the blocks of a result (GIF, MP4 with ffmpeg)")
-    p.add_argument("result", metavar="RESULT.nc")
+    p.add_argument("result", metavar="RESULT.nc", help="a result written by rockdem run")
     p.add_argument("-o", "--output", help="output .gif or .mp4 (default RESULT.gif)")
     p.add_argument("--view", type=_view_arg, default="iso", help=f"{', '.join(VIEWS)} or ELEV,AZIM [deg] (default iso)")
-    p.add_argument("--magnify", type=float, default=1.0, help="factor on displacements and rotations (default 1)")
-    p.add_argument("--fps", type=float, default=20.0, help="frames per second (default 20)")
-    p.add_argument("--speed", type=float, default=1.0, help="simulated seconds per playback second (default 1)")
-    p.add_argument("--max-frames", type=int, default=200, help="most frames (default 200)")
-    p.add_argument("--size", type=int, nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (default 480 360)")
-    p.add_argument("--dpi", type=float, default=80.0, help="pixels per inch of the text (default 80)")
+    p.add_argument("--magnify", type=positive_float, default=1.0, help="factor on displacements and rotations (default 1)")
+    p.add_argument("--fps", type=positive_float, default=20.0, help="frames per second (default 20)")
+    p.add_argument("--speed", type=positive_float, default=1.0, help="simulated seconds per playback second (default 1)")
+    p.add_argument("--max-frames", type=positive_int, default=200, help="most frames (default 200)")
+    p.add_argument("--size", type=integer_at_least(16), nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (default 480 360)")
+    p.add_argument("--dpi", type=positive_float, default=80.0, help="pixels per inch of the text (default 80)")
     p.set_defaults(func=_animate)

@@ -1,4 +1,4 @@
-"""Calibration: parameters that minimise the WME against a reference history (DESIGN §5, paper §3.1, §4).
+"""Calibration: parameters that minimise the WME against a reference history (paper §3.1, §4).
 
 The paper matched alpha (MP) and beta (SP) "by lengthy and tedious trial and error" (§4.2); here
 SciPy does it. One parameter: ``scipy.optimize.minimize_scalar(method="bounded")`` (optionally in
@@ -35,6 +35,8 @@ __all__ = ["Reference", "load_reference", "reference_from_row", "CalibrationResu
 
 QUANTITIES = ("rotation", "displacement")
 SENSITIVITY_STEPS = (-0.20, -0.10, -0.05, -0.02, 0.02, 0.05, 0.10, 0.20)
+MAX_RECENTRES = 8
+"""Times the WME curve is moved onto a better point it found, at most (one parameter)."""
 
 
 @dataclass(frozen=True)
@@ -102,6 +104,10 @@ class CalibrationResult:
         evaluations: every evaluated point (parameter columns, ``wme``), in evaluation order.
         curve: WME around the optimum (one parameter): ``relative_change``, value, ``wme``.
         sensitivity: largest WME increase for +-2/5/10/20 % changes (one parameter), e.g. ``{"5%": 0.12}``.
+        notes: caveats (a better point outside the bounds, a curve not centred on its minimum).
+
+    The optimum is the best point evaluated within the bounds (scan, search and curve alike): the
+    WME curve is re-centred on any better point it finds, so its 0 % row is the optimum.
     """
 
     parameters: list[str]
@@ -110,22 +116,25 @@ class CalibrationResult:
     evaluations: pd.DataFrame
     curve: pd.DataFrame | None = None
     sensitivity: dict[str, float] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
     def report(self) -> str:
         """Plain-text report."""
-        lines = [f"optimum   {', '.join(f'{k} = {v:.6g}' for k, v in self.optimum.items())}", f"WME       {self.wme:.4f}",
+        lines = [f"optimum   {', '.join(f'{k} = {v:.6g}' for k, v in self.optimum.items())}", f"WME       {self.wme:.4g}",
                  f"evaluations {len(self.evaluations)}"]
         if self.curve is not None:
             lines.append("WME around the optimum:")
             for _, r in self.curve.iterrows():
-                lines.append(f"  {r['relative_change']:+6.0%}  {self.parameters[0]} = {r[self.parameters[0]]:.6g}  WME = {r['wme']:.4f}")
+                lines.append(f"  {r['relative_change']:+6.0%}  {self.parameters[0]} = {r[self.parameters[0]]:.6g}  WME = {r['wme']:.4g}")
         if self.sensitivity:
             lines.append("sensitivity (largest WME increase over the optimum for a +- change of the parameter):")
             lines.extend(f"  +-{k:>4s}  dWME = {v:.4f}" for k, v in self.sensitivity.items())
+        lines.extend(f"note: {n}" for n in self.notes)
         return "\n".join(lines)
 
     def to_json(self) -> dict[str, Any]:
-        return {"parameters": self.parameters, "optimum": self.optimum, "wme": self.wme, "sensitivity": self.sensitivity}
+        return {"parameters": self.parameters, "optimum": self.optimum, "wme": self.wme, "sensitivity": self.sensitivity,
+                "notes": self.notes}
 
 
 def calibrate(
@@ -228,22 +237,44 @@ def calibrate(
         cands = [(float(res.fun), list(res.x))]
     best_w, best_x = min(cands, key=lambda c: c[0])
     best_v = to_v(best_x)
-    # rocking WME surfaces are rough: the optimiser's last point is not always its best one
-    top = min(evals, key=lambda e: e["wme"])
-    if top["wme"] < best_w:
-        best_w, best_v = float(top["wme"]), [float(top[k]) for k in keys]
+
+    def inside(e: Mapping[str, Any]) -> bool:
+        return all(b[0] <= float(e[k]) <= b[1] for k, b in zip(keys, bnds))
+
+    def best_evaluated() -> tuple[float, list[float]]:
+        # rocking WME surfaces are rough: the optimiser's last point is not always the best one seen
+        top = min((e for e in evals if inside(e)), key=lambda e: e["wme"])
+        if top["wme"] < best_w:
+            return float(top["wme"]), [float(top[k]) for k in keys]
+        return best_w, best_v
+
+    best_w, best_v = best_evaluated()
     result = CalibrationResult(keys, dict(zip(keys, best_v)), float(best_w), pd.DataFrame(evals))
     if len(keys) == 1 and curve:
         steps = [0.0, *SENSITIVITY_STEPS]
-        vals = [[best_v[0] * (1.0 + s)] for s in steps]
-        w = batch(vals)
+        for _ in range(MAX_RECENTRES + 1):
+            vals = [[best_v[0] * (1.0 + s)] for s in steps]
+            w = batch(vals)
+            previous = best_v
+            best_w, best_v = best_evaluated()
+            if best_v == previous:
+                break  # the curve is centred on the best point evaluated
         cur = pd.DataFrame({"relative_change": steps, keys[0]: [v[0] for v in vals], "wme": w}).sort_values("relative_change")
         result.curve = cur.reset_index(drop=True)
+        result.optimum, result.wme = dict(zip(keys, best_v)), float(best_w)
         w0 = w[0]
         for mag in sorted({abs(s) for s in SENSITIVITY_STEPS}):
             near = [wi for s, wi in zip(steps, w) if abs(abs(s) - mag) < 1e-12]
             result.sensitivity[f"{mag:.0%}"] = float(max(near) - w0)
         result.evaluations = pd.DataFrame(evals)
+    outside = [e for e in evals if not inside(e) and e["wme"] < result.wme]
+    if outside:
+        e = min(outside, key=lambda e: e["wme"])
+        result.notes.append(f"a point outside the bounds did better: {', '.join(f'{k} = {e[k]:.6g}' for k in keys)} "
+                            f"(WME {e['wme']:.4g}); widen the bounds")
+    if result.curve is not None and float(result.curve["wme"].min()) < result.wme:
+        result.notes.append("the curve around the optimum is not centred on its minimum "
+                            f"(after {MAX_RECENTRES} re-centrings); the WME surface is rough here")
     return result
 
 

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -18,8 +20,10 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .materials import JointMaterial
+from .geometry import MAX_FACE_POINTS
+from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
+from .records import STANDARD_GRAVITY
 from .simulate import Monitor
 
 __all__ = [
@@ -33,7 +37,27 @@ __all__ = [
     "example_names",
     "example_case",
     "apply_overrides",
+    "read_toml",
+    "parse_toml_value",
+    "check_plausible",
+    "MAX_MAGNITUDE",
+    "MAX_FILE_BYTES",
+    "MAX_DEPTH",
 ]
+
+MAX_MAGNITUDE = 1e15
+"""Largest magnitude of any number in a case file (SI units): stiffnesses per area reach ~1e14 Pa/m."""
+
+MAX_FILE_BYTES = 8 * 1024**2
+"""Largest case or study file read [bytes]."""
+
+MAX_DEPTH = 16
+"""Deepest nesting of tables and arrays in a case or study file (a case needs 3)."""
+
+PLAUSIBLE: dict[str, tuple[float, float, str]] = {
+    "pga_g": (5.0, 50.0, "the largest peak ground acceleration ever recorded is about 4 g"),
+}
+"""Keys with a plausible range: (warn above, refuse above, why)."""
 
 
 class Table:
@@ -57,6 +81,7 @@ class Table:
             raise ValueError(f"[{self.where}] {key} is required (a number)")
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"[{self.where}] {key} must be a finite number, got {v!r}")
+        check_plausible(v, f"[{self.where}] {key}", key)
         if positive and not v > 0:
             raise ValueError(f"[{self.where}] {key} must be positive, got {v!r}")
         if min_ is not None and v < min_:
@@ -70,13 +95,30 @@ class Table:
             return None
         return self.number(key, positive=positive)
 
-    def integer(self, key: str, default: int | None = None, *, min_: int = 0) -> int:
+    def integer(self, key: str, default: int | None = None, *, min_: int = 0, max_: int | None = None) -> int:
+        """An integer in [min_, max_]; ``default=None`` makes it required."""
         v = self._get(key, default)
+        if v is None:
+            raise ValueError(f"[{self.where}] {key} is required (an integer)")
         if isinstance(v, bool) or not isinstance(v, int):
             raise ValueError(f"[{self.where}] {key} must be an integer, got {v!r}")
         if v < min_:
             raise ValueError(f"[{self.where}] {key} must be >= {min_}, got {v!r}")
+        if max_ is not None and v > max_:
+            raise ValueError(f"[{self.where}] {key} = {v} exceeds the limit of {max_}")
         return v
+
+    def points(self, across: int = 2, along: int = 2) -> tuple[int, int]:
+        """Interface points per face from ``points_across`` and ``points_along`` (at most
+        :data:`~rockdem.geometry.MAX_FACE_POINTS` per face)."""
+        a = self.integer("points_across", across, min_=1, max_=MAX_FACE_POINTS)
+        b = self.integer("points_along", along, min_=1, max_=MAX_FACE_POINTS)
+        if a * b > MAX_FACE_POINTS:
+            raise ValueError(
+                f"[{self.where}] points_across x points_along = {a} x {b} exceeds the limit of {MAX_FACE_POINTS} "
+                "points per face (the paper uses 2 to 15 across)"
+            )
+        return a, b
 
     def boolean(self, key: str, default: bool) -> bool:
         v = self._get(key, default)
@@ -98,12 +140,33 @@ class Table:
         v = self._get(key, default)
         if v is None:
             raise ValueError(f"[{self.where}] {key} is required (a list of {size} numbers)")
-        try:
-            arr = np.asarray(v, dtype=float).reshape(size)
-        except (TypeError, ValueError):
-            raise ValueError(f"[{self.where}] {key} must be a list of {size} numbers, got {v!r}") from None
+        arr = self._numbers(key, v, f"a list of {size} numbers")
+        if arr.shape != (size,):
+            raise ValueError(f"[{self.where}] {key} must be a list of {size} numbers, got {v!r}")
+        return arr
+
+    def numbers(self, key: str, *, positive: bool = False) -> np.ndarray:
+        """A required non-empty list of finite numbers (e.g. block heights)."""
+        v = self._get(key, None)
+        what = "a non-empty list of " + ("positive " if positive else "") + "numbers"
+        if v is None:
+            raise ValueError(f"[{self.where}] {key} is required ({what})")
+        arr = self._numbers(key, v, what)
+        if arr.size == 0:
+            raise ValueError(f"[{self.where}] {key} must be {what}, got {v!r}")
+        if positive and not np.all(arr > 0):
+            k = int(np.argmin(arr > 0))
+            raise ValueError(f"[{self.where}] {key} must be {what}; {key}[{k}] = {float(arr[k])!r}")
+        return arr
+
+    def _numbers(self, key: str, v: Any, what: str) -> np.ndarray:
+        if not isinstance(v, (list, tuple)) or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v):
+            raise ValueError(f"[{self.where}] {key} must be {what}, got {_short(v)}")
+        arr = np.asarray(v, dtype=float)
         if not np.all(np.isfinite(arr)):
-            raise ValueError(f"[{self.where}] {key} must be finite, got {v!r}")
+            raise ValueError(f"[{self.where}] {key} must be finite, got {_short(v)}")
+        for x in arr:
+            check_plausible(float(x), f"[{self.where}] {key}", key)
         return arr
 
     def sub(self, key: str) -> "Table":
@@ -111,6 +174,7 @@ class Table:
         return Table(self._get(key, {}), key if self.where == "case" else f"{self.where}.{key}")
 
     def raw(self, key: str, default: Any = None) -> Any:
+        """The value as read (the caller checks it)."""
         return self._get(key, default)
 
     def finish(self) -> None:
@@ -120,6 +184,27 @@ class Table:
             raise ValueError(
                 f"[{self.where}] unknown key(s) {unknown}; accepted keys are {sorted(self.used)}"
             )
+
+
+def _short(v: Any, n: int = 60) -> str:
+    text = repr(v)
+    return text if len(text) <= n else text[: n - 5] + " ...]"
+
+
+def check_plausible(value: float, what: str, key: str = "") -> None:
+    """Refuse a number beyond :data:`MAX_MAGNITUDE`, and a value of a :data:`PLAUSIBLE` ``key``
+    above its range (a warning above its plausible limit). ``what`` names the value in messages."""
+    if abs(value) > MAX_MAGNITUDE:
+        raise ValueError(
+            f"{what} = {value!r} is beyond any plausible value (|value| > {MAX_MAGNITUDE:g} in SI units); "
+            "check the value and its units"
+        )
+    if key in PLAUSIBLE:
+        warn, refuse, why = PLAUSIBLE[key]
+        if value > refuse:
+            raise ValueError(f"{what} = {value!r} is not plausible (above {refuse:g}; {why}); check the value and its units")
+        if value > warn:
+            warnings.warn(f"{what} = {value!r} is above {warn:g}: {why}; check the value and its units", UserWarning, stacklevel=3)
 
 
 @dataclass(frozen=True)
@@ -188,23 +273,29 @@ def joint_material(t: Table, *, spacing: float) -> JointMaterial:
     e = t.optional_number("youngs_modulus", positive=True)
     if (kn is None) == (e is None):
         raise ValueError(f"[{t.where}] give exactly one of kn [Pa/m] or youngs_modulus [Pa] (kn = E / l)")
+    if not (math.isfinite(spacing) and spacing > 0):
+        raise ValueError(f"[{t.where}] the joint spacing l of kn = E / l must be positive [m], got {spacing!r}")
     nu = t.number("poisson", 0.25)
+    if not -1.0 < nu < 0.5:
+        raise ValueError(f"[{t.where}] poisson must lie in (-1, 0.5), got {nu!r}")
     kn = e / spacing if kn is None else kn
     ks = t.optional_number("ks", positive=True)
-    from .materials import ks_from_kn
-
-    mat = JointMaterial(
-        kn=kn,
-        ks=ks_from_kn(kn, nu) if ks is None else ks,
-        friction_angle=t.number("friction_angle_deg", 30.0),
-        cohesion=t.number("cohesion", 0.0, min_=0.0),
-        tension=t.number("tension", 0.0, min_=0.0),
-        residual_friction_angle=t.optional_number("residual_friction_angle_deg"),
-        residual_cohesion=t.number("residual_cohesion", 0.0, min_=0.0),
-        beta=t.optional_number("beta"),
+    values = check_material(
+        {
+            "kn": kn,
+            "ks": ks_from_kn(kn, nu) if ks is None else ks,
+            "friction_angle": t.number("friction_angle_deg", 30.0),
+            "cohesion": t.number("cohesion", 0.0, min_=0.0),
+            "tension": t.number("tension", 0.0, min_=0.0),
+            "residual_friction_angle": t.optional_number("residual_friction_angle_deg"),
+            "residual_cohesion": t.number("residual_cohesion", 0.0, min_=0.0),
+            "beta": t.optional_number("beta"),
+        },
+        f"[{t.where}]",
+        {"friction_angle": "friction_angle_deg", "residual_friction_angle": "residual_friction_angle_deg",
+         "kn": "kn (or youngs_modulus / l)"},
     )
-    mat.validate(f"[{t.where}]")
-    return mat
+    return JointMaterial(**values)  # type: ignore[arg-type]
 
 
 @specimen("block")
@@ -218,7 +309,7 @@ def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
     height = t.number("height", positive=True)
     length = t.number("length", 1.0, positive=True)
     density = t.number("density", 1800.0, positive=True)
-    pts = (t.integer("points_across", 2, min_=1), t.integer("points_along", 2, min_=1))
+    pts = t.points()
     mat = joint_material(t, spacing=height)
     b.default_material = mat
     size = 2.0 * max(width, length, height)
@@ -264,17 +355,65 @@ def _gravity_only(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: 
     """Gravity alone (settlement, static checks)."""
 
 
-def load_case(path: str | Path) -> dict[str, Any]:
-    """Read a TOML case file into a dict (no validation yet)."""
+def read_toml(path: str | os.PathLike[str], what: str = "case file") -> dict[str, Any]:
+    """Read a TOML file safely: a regular file (not a folder, FIFO or device) of at most
+    :data:`MAX_FILE_BYTES`, UTF-8 (a byte-order mark is accepted), nested at most :data:`MAX_DEPTH`
+    levels. Errors name ``what`` and the path."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise ValueError(f"{what}: give a file path, got {path!r}")
     p = Path(path)
     if not p.exists():
-        raise FileNotFoundError(f"case file {p} does not exist")
+        raise FileNotFoundError(f"{what} {p} does not exist")
+    if not p.is_file():
+        kind = "a folder" if p.is_dir() else "not a regular file (a FIFO, socket or device)"
+        raise ValueError(f"{what} {p} is {kind}; give a TOML file")
+    with p.open("rb") as fh:
+        raw = fh.read(MAX_FILE_BYTES + 1)
+    if len(raw) > MAX_FILE_BYTES:
+        raise ValueError(f"{what} {p} is larger than {MAX_FILE_BYTES // 1024**2} MiB; a TOML case or study file is a few kB")
     try:
-        with p.open("rb") as fh:
-            data = tomllib.load(fh)
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise ValueError(
+            f"{what} {p} is not UTF-8 text (byte 0x{raw[exc.start]:02x} at offset {exc.start}); save it as UTF-8"
+        ) from None
+    try:
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{p}: not valid TOML: {exc}") from None
-    data.setdefault("name", p.stem)
+        raise ValueError(f"{what} {p}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"{what} {p}: tables or arrays nested too deeply (more than {MAX_DEPTH} levels)") from None
+    _check_depth(data, f"{what} {p}")
+    return data
+
+
+def parse_toml_value(text: str, what: str) -> Any:
+    """A TOML value (``5``, ``"name"``, ``[1, 2]``, ``{a = 1}``), or ``text`` itself when it is not one."""
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        return text
+    except RecursionError:
+        raise ValueError(f"{what}: value nested too deeply (more than {MAX_DEPTH} levels)") from None
+    _check_depth(value, what)
+    return value
+
+
+def _check_depth(data: Any, what: str) -> None:
+    """Refuse tables or arrays nested deeper than :data:`MAX_DEPTH`."""
+    stack = [(data, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise ValueError(f"{what}: tables or arrays nested more than {MAX_DEPTH} levels deep; a case needs 3")
+        children = node.values() if isinstance(node, dict) else node if isinstance(node, list) else ()
+        stack.extend((c, depth + 1) for c in children)
+
+
+def load_case(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """Read a TOML case file into a dict (no validation yet; see :func:`read_toml` for the checks)."""
+    data = read_toml(path, "case file")
+    data.setdefault("name", Path(path).stem)
     return data
 
 
@@ -292,18 +431,21 @@ def example_case(name: str) -> dict[str, Any]:
     return data
 
 
-def apply_overrides(data: dict[str, Any], overrides: list[str]) -> dict[str, Any]:
+def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, Any]:
     """Apply ``table.key=value`` overrides (value parsed as TOML, else kept as a string)."""
-    out = copy.deepcopy(data)
+    if not isinstance(data, Mapping):
+        raise ValueError(f"overrides apply to a case (a dict), got {_short(data)}")
+    if isinstance(overrides, (str, bytes)) or not all(isinstance(o, str) for o in overrides):
+        raise ValueError(f"overrides must be a list of 'table.key=value' strings, got {_short(overrides)}")
+    out = copy.deepcopy(dict(data))
     for item in overrides:
         if "=" not in item:
             raise ValueError(f"--set {item!r}: use table.key=value, e.g. damping.beta=0.005")
         path, value = item.split("=", 1)
-        try:
-            parsed = tomllib.loads(f"v = {value}")["v"]
-        except tomllib.TOMLDecodeError:
-            parsed = value
+        parsed = parse_toml_value(value, f"--set {path.strip()}")
         keys = path.strip().split(".")
+        if not all(k.strip() for k in keys):
+            raise ValueError(f"--set {item[:60]!r}: use table.key=value, e.g. damping.beta=0.005")
         node = out
         for k in keys[:-1]:
             node = node.setdefault(k, {})
@@ -347,6 +489,9 @@ def parse_case(data: Mapping[str, Any]) -> Case:
     ctx: dict[str, Any] = {"run": run, "attrs": {"loading": lkind}, "series": {}}
     LOADINGS[lkind](load_t, builder, monitors, ctx)
     load_t.finish()
+    pga = ctx["attrs"].get("earthquake_pga_m_s2")
+    if isinstance(pga, float) and "pga_g" not in load_t.data:  # a record scaled by ``scale``
+        check_plausible(float(f"{pga / STANDARD_GRAVITY:.4g}"), "[loading] the scaled record's peak ground acceleration [g] (see scale)", "pga_g")
     out_t = top.sub("output")
     output = {
         "directory": out_t.string("directory", ""),

@@ -1,14 +1,26 @@
-"""The ``rockdem`` command line: one sub-command per module, all over the Python API."""
+"""The ``rockdem`` command line: one sub-command per module, all over the Python API.
+
+Exit status: 0 done; 1 a study finished with failed runs; 2 bad input (the message names the key,
+flag or file); 3 the run diverged (the result holds the frames before it); 128 + N stopped by
+signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP), after saving what was computed.
+"""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import math
+import signal
 import sys
+import threading
+import warnings
+from collections.abc import Callable, Iterator
 
 # Modules that contribute a sub-command through ``register_cli(subparsers)``.
 _COMMAND_MODULES = (
     "rockdem.run_cli",
+    "rockdem.records",
     "rockdem.advisor",
     "rockdem.plots",
     "rockdem.animate",
@@ -17,14 +29,123 @@ _COMMAND_MODULES = (
     "rockdem.reproduce",
 )
 
+EXIT_BAD_INPUT = 2
+EXIT_DIVERGED = 3
+STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+"""Signals that stop a run or a study like Ctrl-C: the work done so far is saved."""
 
-def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with every registered sub-command."""
-    parser = argparse.ArgumentParser(
-        prog="rockdem",
-        description="3D rigid-block DEM for rocking masonry, with defensible damping.",
-    )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+MAX_NUMBER = 1e15
+"""Largest magnitude accepted for a numeric flag (as for case-file numbers)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """A stop signal (SIGINT, SIGTERM, SIGHUP) raised as KeyboardInterrupt; exit status 128 + signum."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+def exit_status(exc: KeyboardInterrupt) -> int:
+    """128 + the signal number of an interruption (130 for a plain Ctrl-C)."""
+    return 128 + int(getattr(exc, "signum", signal.SIGINT))
+
+
+def _set_handlers(handler: Callable[[int, object], None] | int) -> dict[int, object]:
+    """Install ``handler`` for the stop signals (main thread only); returns the previous ones."""
+    old: dict[int, object] = {}
+    if threading.current_thread() is not threading.main_thread():
+        return old
+    for name in STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            old[sig] = signal.signal(sig, handler)
+    return old
+
+
+def _restore(old: dict[int, object]) -> None:
+    for sig, h in old.items():
+        signal.signal(sig, h)  # type: ignore[arg-type]
+
+
+@contextlib.contextmanager
+def stop_on_signals(received: list[int] | None = None) -> Iterator[list[int]]:
+    """Within the block, SIGTERM and SIGHUP raise :class:`Interrupted` (a KeyboardInterrupt), as
+    Ctrl-C does, so that ``simulate()`` returns the frames computed so far and a study stops its
+    workers. The signal numbers received are appended to the yielded list."""
+    got = [] if received is None else received
+
+    def handler(signum: int, frame: object) -> None:
+        got.append(signum)
+        raise Interrupted(signum)
+
+    old = _set_handlers(handler)
+    try:
+        yield got
+    finally:
+        _restore(old)
+
+
+@contextlib.contextmanager
+def hold_signals(received: list[int], what: str = "saving the results") -> Iterator[None]:
+    """Within the block (e.g. saving), the first stop signal is held with a note on stderr and
+    the work goes on; a second one raises :class:`Interrupted` (the save is abandoned)."""
+    held: list[int] = []
+
+    def handler(signum: int, frame: object) -> None:
+        received.append(signum)
+        if held:
+            raise Interrupted(signum)
+        held.append(signum)
+        print(f"rockdem: {what}; interrupt again to abandon", file=sys.stderr, flush=True)
+
+    old = _set_handlers(handler)
+    try:
+        yield
+    finally:
+        _restore(old)
+
+
+def _number(kind: str) -> Callable[[str], float]:
+    """An argparse type: a finite number that is ``kind`` ("positive" or "non-negative")."""
+
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            v = math.nan
+        if not math.isfinite(v) or (v <= 0 if kind == "positive" else v < 0):
+            raise argparse.ArgumentTypeError(f"must be a {kind} number, got {text!r}")
+        if abs(v) > MAX_NUMBER:
+            raise argparse.ArgumentTypeError(f"{text} is beyond any plausible value (> {MAX_NUMBER:g}); check the units")
+        return v
+
+    parse.__name__ = f"{kind} number"
+    return parse
+
+
+def integer_at_least(low: int) -> Callable[[str], int]:
+    """An argparse type: an integer >= ``low``."""
+
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            v = low - 1
+        if v < low:
+            raise argparse.ArgumentTypeError(f"must be an integer >= {low}, got {text!r}")
+        return v
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
+positive_float = _number("positive")
+non_negative_float = _number("non-negative")
+positive_int = integer_at_least(1)
+
+
+def _add_commands(sub: argparse._SubParsersAction) -> None:
     for name in _COMMAND_MODULES:
         try:
             module = importlib.import_module(name)
@@ -32,22 +153,52 @@ def build_parser() -> argparse.ArgumentParser:
             if exc.name == name:  # a module still being written: skip its command
                 continue
             raise
-        module.register_cli(sub)
+        register = getattr(module, "register_cli", None)
+        if callable(register):  # a module without a command yet (e.g. records before its CLI)
+            register(sub)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The top-level parser with every registered sub-command."""
+    from . import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="rockdem",
+        description="3D rigid-block DEM for rocking masonry, with defensible damping "
+        "(Galvez, Sorrentino, Dizhur & Ingham, Earthquake Engng Struct Dyn 2022, doi:10.1002/eqe.3598).",
+        epilog="Exit status: 0 done; 1 a study with failed runs; 2 bad input; 3 the run diverged; "
+        "128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP) after saving what was computed.",
+    )
+    parser.add_argument("--version", action="version", version=f"rockdem {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    _add_commands(sub)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``rockdem`` console script."""
+    """Entry point of the ``rockdem`` console script; returns the exit status (see the module)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: --help, --version (0) or a bad flag (2, message printed)
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_BAD_INPUT)
     if not getattr(args, "func", None):
         parser.print_help()
-        return 2
+        return EXIT_BAD_INPUT
+    def show_warning(message: Warning | str, category: type[Warning], *rest: object, **kw: object) -> None:
+        print(f"rockdem {args.command}: warning: {message}", file=sys.stderr)
+
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = show_warning  # one line, no source excerpt
+            return int(args.func(args) or 0)
     except (ValueError, FileNotFoundError) as exc:
         print(f"rockdem {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt as exc:
+        name = signal.Signals(exit_status(exc) - 128).name
+        print(f"rockdem {args.command}: stopped by {name}", file=sys.stderr)
+        return exit_status(exc)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,9 +1,10 @@
-"""Incremental dynamic analysis (IDA) and lognormal fragility curves (DESIGN §5).
+"""Incremental dynamic analysis (IDA) and lognormal fragility curves.
 
 Each record of a set is scaled to a range of peak ground accelerations (PGA [g]); each (record,
 PGA) pair is a :class:`rockdem.studies.RunSpec` run through the study executors and store. A run
 fails (collapse) when the block overturns or when its peak rotation exceeds ``drift_limit`` x eta
-(eta = slenderness angle). The fragility P(fail | PGA) = Phi(ln(PGA / theta) / beta) is fitted by
+(eta = slenderness angle). Only runs that finished (status "ok") have an outcome: runs that
+raised an error (e.g. an unreadable record) or diverged are counted apart and never enter a fit. The fragility P(fail | PGA) = Phi(ln(PGA / theta) / beta) is fitted by
 maximum likelihood: on (PGA, failed) outcomes with a binomial likelihood (Baker 2015), or on the
 per-record collapse capacities of an IDA (lognormal MLE: theta = exp(mean ln IM), beta = std ln IM
 with ddof = 0).
@@ -33,6 +34,9 @@ __all__ = [
     "ida_specs",
     "run_ida",
     "failed",
+    "completed",
+    "IdaCounts",
+    "ida_counts",
     "collapse_capacities",
     "plot_ida",
     "plot_fragility",
@@ -102,38 +106,92 @@ def ida_specs(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequ
     return [RunSpec.make(b, fixed, duration=duration, record=str(r), pga_g=float(a)) for r in records for a in pga_g]
 
 
+def completed(table: pd.DataFrame) -> pd.Series:
+    """Runs whose outcome is known: status "ok" (not "error", not "diverged")."""
+    if "status" not in table:
+        return pd.Series(True, index=table.index)
+    return table["status"].eq("ok")
+
+
 def failed(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
-    """Failure of each run: overturned, or peak rotation > drift_limit x eta."""
-    f = table["overturned"].astype(bool)
-    if drift_limit is not None:
-        f = f | (table["max_rotation_over_eta"].astype(float) > drift_limit)
+    """Failure of each run: overturned, or peak rotation > drift_limit x eta (a nullable boolean:
+    <NA> for runs without an outcome, see :func:`completed`)."""
+    done = completed(table)
+    f = pd.Series(pd.NA, index=table.index, dtype="boolean")
+    if done.any():
+        sub = table[done]
+        g = sub["overturned"].astype(bool)
+        if drift_limit is not None:
+            g = g | (sub["max_rotation_over_eta"].astype(float) > drift_limit)
+        f[done] = g.to_numpy()
     return f
 
 
+@dataclass(frozen=True)
+class IdaCounts:
+    """Runs of an IDA by outcome: ``failures`` and ``survivals`` of the completed runs, ``errors``
+    (status "error") and ``diverged`` (status "diverged") are outside the fit."""
+
+    runs: int
+    failures: int
+    survivals: int
+    errors: int
+    diverged: int
+
+    def line(self) -> str:
+        """One-line summary for the command line."""
+        out = f"{self.runs} runs: {self.failures} failures, {self.survivals} survivals"
+        apart = [f"{n} {what}" for n, what in ((self.errors, "errored"), (self.diverged, "diverged")) if n]
+        if apart:
+            out += f"; {', '.join(apart)} (no outcome: not in the fit)"
+        return out
+
+
+def ida_counts(table: pd.DataFrame) -> IdaCounts:
+    """Count the runs of a table with a ``failed`` column by outcome."""
+    status = table["status"] if "status" in table else pd.Series("ok", index=table.index)
+    f = table["failed"].astype("boolean")
+    return IdaCounts(len(table), int(f.sum()), int((~f).sum()),  # <NA> (no outcome) counts in neither
+                     int(status.eq("error").sum()), int(status.eq("diverged").sum()))
+
+
 def collapse_capacities(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
-    """Per record: the lowest PGA [g] that fails (NaN if none does)."""
+    """Per record: the lowest PGA [g] that fails (NaN if none does), over the completed runs."""
     t = table.assign(failed=failed(table, drift_limit))
-    return t[t.failed].groupby("record")["pga_g"].min().reindex(sorted(t["record"].unique()))
+    t = t[completed(t)]
+    return t[t.failed.astype(bool)].groupby("record")["pga_g"].min().reindex(sorted(t["record"].unique()))
 
 
 def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], out: str | os.PathLike[str], *,
             fixed: Mapping[str, Any] | None = None, duration: float | None = None, drift_limit: float | None = None,
             executor: str = "process", workers: int | None = None, scheduler: Any = None,
             progress: bool = True) -> tuple[pd.DataFrame, Fragility | None]:
-    """Run an IDA into folder ``out`` (store, table, plots) and fit the fragility (None if it cannot)."""
+    """Run an IDA into folder ``out`` (store, table, plots) and fit the fragility (None if it cannot).
+
+    The table's ``failed`` column is empty for runs without an outcome (errors, divergence); only
+    the completed runs enter the fit and the plots.
+
+    Raises:
+        ValueError: no run completed (the table is written first; the message gives the first error).
+    """
     specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration)
     store = Store(out)
     execute(specs, store, executor=executor, workers=workers, scheduler=scheduler, progress=progress)
     df = study_table(store, specs=specs)
     df = df.assign(failed=failed(df, drift_limit))
     save_table(df, out)
+    done = df[completed(df)]
+    if done.empty:
+        first = df["error"].dropna().iloc[0] if "error" in df and df["error"].notna().any() else "no error message"
+        raise ValueError(f"none of the {len(df)} IDA runs completed ({ida_counts(df).line()}), so there is no "
+                         f"fragility; first error: {first}. See {Path(out) / 'table.csv'}")
     try:
-        frag = fit_fragility_mle(df["pga_g"], df["failed"].astype(int))
+        frag = fit_fragility_mle(done["pga_g"], done["failed"].astype(int))
     except ValueError:
         frag = None
-    plot_ida(df, Path(out) / "ida.png", drift_limit=drift_limit)
+    plot_ida(done, Path(out) / "ida.png", drift_limit=drift_limit)
     if frag is not None:
-        plot_fragility(frag, df, Path(out) / "fragility.png")
+        plot_fragility(frag, done, Path(out) / "fragility.png")
     return df, frag
 
 
@@ -153,7 +211,7 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     for rec, g in table.sort_values("pga_g").groupby("record"):
         x = np.minimum(g["max_rotation_over_eta"].astype(float), 1.5)
         ax.plot(x, g["pga_g"], "-o", ms=3, label=Path(str(rec)).stem)
-        f = failed(g, drift_limit)
+        f = failed(g, drift_limit).fillna(False).astype(bool)
         ax.plot(x[f], g["pga_g"][f], "x", color="k")
     if drift_limit is not None:
         ax.axvline(drift_limit, color="r", lw=0.8, ls="--")
@@ -174,7 +232,7 @@ def plot_fragility(frag: Fragility, table: pd.DataFrame | None, path: str | os.P
     x = np.linspace(1e-3, hi, 300)
     ax.plot(x, frag.probability(x), label=f"theta = {frag.theta:.3g} g, beta = {frag.beta:.3g}")
     if table is not None and "failed" in table:
-        obs = table.groupby("pga_g")["failed"].mean()
+        obs = table[completed(table)].assign(failed=lambda t: t["failed"].astype(float)).groupby("pga_g")["failed"].mean()
         ax.plot(obs.index, obs.values, "o", label="observed fraction")
     ax.set_xlabel("PGA [g]")
     ax.set_ylabel("P(failure)")
@@ -201,9 +259,9 @@ def _fragility_cli(args: argparse.Namespace) -> int:
     df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,
                        drift_limit=args.drift_limit, executor=args.executor or "process", workers=args.workers,
                        scheduler=args.scheduler, progress=not args.no_progress)
-    print(f"{len(df)} runs, {int(df['failed'].sum())} failures -> {Path(args.out) / 'table.csv'}")
+    print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}")
     if frag is None:
-        print("fragility: not fitted (all runs failed or none did; widen the PGA range)")
+        print("fragility: not fitted (every completed run failed, or none did; widen the PGA range)")
     else:
         print(f"fragility: median {frag.theta:.4g} g, dispersion {frag.beta:.4g}")
     return 0
@@ -212,7 +270,7 @@ def _fragility_cli(args: argparse.Namespace) -> int:
 def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """Add ``fragility``."""
     p = subparsers.add_parser("fragility", help="IDA over records and PGA levels, with a lognormal fragility fit")
-    p.add_argument("records", nargs="+", help="record names (shared ground-motion folder) or files")
+    p.add_argument("records", nargs="+", help="shipped record names (`rockdem records`), files, or file names in $ROCKDEM_DATA")
     p.add_argument("--base", default="free-rocking", help="base case (its block; the loading is replaced)")
     p.add_argument("--pga", nargs=3, default=(0.05, 1.0, 10), metavar=("LOW", "HIGH", "N"), help="PGA levels [g]")
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]")

@@ -6,6 +6,7 @@ metres, density in kg/m^3, mass in kg, inertia in kg*m^2.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,9 +22,16 @@ __all__ = [
     "face_points",
     "FaceGrid",
     "face_grid",
+    "MAX_FACE_POINTS",
 ]
 
 _REL_TOL = 1e-9
+
+MAX_FACE_POINTS = 10_000
+"""Most interface points on one face (across x along); the paper uses 2 to 15 across."""
+
+MAX_LENGTH = 1e6
+"""Largest side of a box [m] (larger values are unit mistakes or overflow the mass properties)."""
 
 
 @dataclass(frozen=True)
@@ -94,7 +102,10 @@ def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
     Raises:
         ValueError: degenerate (flat, collinear, too few points) or non-convex vertex sets.
     """
-    v = np.asarray(vertices, dtype=float)
+    try:
+        v = np.asarray(vertices, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: vertices must be an (n, 3) array of numbers [m], got {vertices!r}"[:300]) from None
     if v.ndim != 2 or v.shape[1] != 3 or v.shape[0] < 4:
         raise ValueError(f"{name}: vertices must be an (n, 3) array with n >= 4, got shape {v.shape}")
     if not np.all(np.isfinite(v)):
@@ -171,9 +182,14 @@ def _drop_collinear(v: NDArray[np.float64], order: NDArray[np.int64], tol: float
 def box(b: float, l: float, h: float, *, center: ArrayLike = (0.0, 0.0, 0.0), name: str = "box") -> Polyhedron:
     """Rectangular box of width ``b`` (x), length ``l`` (y) and height ``h`` (z) [m], centred at ``center``."""
     for field, val in (("b (width, x)", b), ("l (length, y)", l), ("h (height, z)", h)):
-        if not np.isfinite(val) or val <= 0.0:
-            raise ValueError(f"{name}: {field} must be a positive length in metres, got {val!r}")
-    c = np.asarray(center, dtype=float)
+        if isinstance(val, bool) or not isinstance(val, numbers.Real) or not np.isfinite(val) or not 0.0 < val <= MAX_LENGTH:
+            raise ValueError(f"{name}: {field} must be a positive length in metres (at most {MAX_LENGTH:g}), got {val!r}")
+    try:
+        c = np.asarray(center, dtype=float)
+    except (TypeError, ValueError):
+        c = np.full(0, np.nan)
+    if c.shape != (3,) or not np.all(np.isfinite(c)):
+        raise ValueError(f"{name}: center must be a finite point (x, y, z) [m], got {center!r}")
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
     return convex_hull(c + 0.5 * signs * np.array([b, l, h]), name=name)
 
@@ -184,6 +200,8 @@ def mass_properties(poly: Polyhedron, density: float) -> MassProperties:
     Each face is fanned into triangles which, with a reference point, form signed tetrahedra whose
     volume, first and second moments are summed exactly.
     """
+    if isinstance(density, bool) or not isinstance(density, numbers.Real) or not (np.isfinite(density) and density > 0):
+        raise ValueError(f"density must be a positive number [kg/m^3], got {density!r}")
     v = poly.vertices
     ref = v.mean(axis=0)
     vol = 0.0
@@ -290,8 +308,16 @@ def face_grid(poly: Polyhedron, face: int, n_across: int, n_along: int) -> FaceG
     what the contact law clips against a partner face (see ``docs/contacts.md``): the force of a
     point is carried by the part of its cell that the partner covers.
     """
-    if n_across < 1 or n_along < 1:
-        raise ValueError(f"interface points: need at least 1 point across and along, got {n_across} x {n_along}")
+    for what, n in (("across", n_across), ("along", n_along)):
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 1:
+            raise ValueError(f"interface points: the count {what} must be an integer >= 1, got {n!r}")
+    if n_across * n_along > MAX_FACE_POINTS:
+        raise ValueError(
+            f"interface points: {n_across} x {n_along} per face exceed the limit of {MAX_FACE_POINTS} "
+            "(the paper uses 2 to 15 across)"
+        )
+    if isinstance(face, bool) or not isinstance(face, numbers.Integral) or not 0 <= face < len(poly.faces):
+        raise ValueError(f"interface points: face must be an index in [0, {len(poly.faces)}), got {face!r}")
     v = poly.vertices[poly.faces[face]]
     n = poly.normals[face]
     c = v.mean(axis=0)

@@ -1,4 +1,4 @@
-"""Earthquake loading and quasi-static pushover (DESIGN §2 "Loading"; paper §3.3 and §4).
+"""Earthquake loading and quasi-static pushover (paper §3.3 and §4).
 
 Earthquakes can be applied in two equivalent frames:
 
@@ -45,7 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 from .case import Table, loading
 from .geometry import box, mass_properties
 from .model import GROUND, Damping, ModelBuilder, Motion
-from .records import STANDARD_GRAVITY, GroundMotion, read_record, shared_record_path
+from .records import STANDARD_GRAVITY, GroundMotion, read_record, record_path
 from .simulate import Monitor, simulate
 
 __all__ = [
@@ -92,15 +92,9 @@ class EarthquakeInput:
 
 
 def resolve_record(name: str | Path) -> Path:
-    """Find a record file: an absolute path as is, a path existing relative to the working folder
-    as is, else a file of that name in the shared ground-motion folder
-    (:func:`rockdem.records.shared_record_path`)."""
-    p = Path(name).expanduser()
-    if p.is_absolute() or p.exists():
-        if not p.exists():
-            raise FileNotFoundError(f"record file {p} does not exist")
-        return p
-    return shared_record_path(str(name))
+    """Find a record file: a path, a file name in ``$ROCKDEM_DATA`` or a shipped record's short or
+    file name, in that order (:func:`rockdem.records.record_path`)."""
+    return record_path(name)
 
 
 def prepare_record(
@@ -535,16 +529,16 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
 
 
 def _read_table_record(t: Table, key: str, units: str | None, dt: float | None) -> GroundMotion:
-    name = t.string(key)
-    return read_record(resolve_record(name), units=units, dt=dt)
+    return read_record(t.string(key), units=units, dt=dt)
 
 
 @loading("earthquake")
 def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
     """An earthquake record on the foundation (or as inertial forces), starting from rest.
 
-    Keys: record (file path, or a file name in the shared ground-motion folder), units ("g",
-    "m/s2", "cm/s2"; optional for AT2), dt [s] (single-column files), scale (default 1) or pga_g
+    Keys: record (a shipped record's short name, e.g. "elcentro-rsn6" (``rockdem records`` lists
+    them), or a file: a path relative to the working folder, or a file name in ``$ROCKDEM_DATA``),
+    units ("g", "m/s2", "cm/s2"; optional for AT2 and shipped records), dt [s] (single-column files), scale (default 1) or pga_g
     (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
     the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
     baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0).
@@ -556,7 +550,7 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
     gm = _read_table_record(t, "record", units, dt)
     vert = t.raw("vertical", False)
     if isinstance(vert, str):
-        gv = read_record(resolve_record(vert), units=units, dt=dt)
+        gv = read_record(vert, units=units, dt=dt)
         n = min(gv.npts, gm.npts)
         if abs(gv.dt - gm.dt) > 1e-9 * gm.dt:
             raise ValueError(f"[{t.where}] vertical record dt {gv.dt} s differs from the record's {gm.dt} s")

@@ -3,25 +3,67 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import numbers
+from dataclasses import dataclass, fields
+from typing import Any, Mapping
 
-__all__ = ["JointMaterial", "kn_from_modulus", "ks_from_kn"]
+__all__ = ["JointMaterial", "check_material", "kn_from_modulus", "ks_from_kn", "real_number"]
+
+
+def real_number(value: Any, what: str) -> float:
+    """``value`` as a finite float, or ValueError naming ``what`` (strings, booleans, None, NaN and
+    infinities are refused)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{what} must be a finite number, got {value!r}")
+    return float(value)
 
 
 def kn_from_modulus(youngs_modulus: float, joint_spacing: float) -> float:
     """Normal joint stiffness kn = E / l [Pa/m] (paper §3; l = H for one block, H/n_b for n_b blocks)."""
-    if not youngs_modulus > 0:
+    if not real_number(youngs_modulus, "youngs_modulus [Pa]") > 0:
         raise ValueError(f"youngs_modulus must be positive [Pa], got {youngs_modulus!r}")
-    if not joint_spacing > 0:
+    if not real_number(joint_spacing, "joint_spacing [m]") > 0:
         raise ValueError(f"joint_spacing must be positive [m], got {joint_spacing!r}")
     return youngs_modulus / joint_spacing
 
 
 def ks_from_kn(kn: float, poisson: float = 0.25) -> float:
     """Shear joint stiffness ks = kn / (2 (1 + nu)) [Pa/m] (paper §3; 0.4 kn for nu = 0.25)."""
-    if not -1.0 < poisson < 0.5:
+    if not real_number(kn, "kn [Pa/m]") > 0:
+        raise ValueError(f"kn must be a positive stiffness per area [Pa/m], got {kn!r}")
+    if not -1.0 < real_number(poisson, "poisson") < 0.5:
         raise ValueError(f"poisson must lie in (-1, 0.5), got {poisson!r}")
     return kn / (2.0 * (1.0 + poisson))
+
+
+# field -> (required, test, what it must be); None is accepted for the optional fields
+_CHECKS: dict[str, tuple[bool, Any, str]] = {
+    "kn": (True, lambda v: v > 0, "a positive stiffness per area [Pa/m]"),
+    "ks": (False, lambda v: v > 0, "a positive stiffness per area [Pa/m]"),
+    "friction_angle": (True, lambda v: 0 <= v < 90, "an angle in [0, 90) degrees"),
+    "cohesion": (True, lambda v: v >= 0, "a non-negative stress [Pa]"),
+    "tension": (True, lambda v: v >= 0, "a non-negative stress [Pa]"),
+    "residual_friction_angle": (False, lambda v: 0 <= v < 90, "an angle in [0, 90) degrees"),
+    "residual_cohesion": (True, lambda v: v >= 0, "a non-negative stress [Pa]"),
+    "beta": (False, lambda v: v >= 0, "a non-negative time [s]"),
+}
+
+
+def check_material(values: Mapping[str, Any], where: str, names: Mapping[str, str] | None = None) -> dict[str, float | None]:
+    """Check joint-material values (the :class:`JointMaterial` fields present in ``values``) and
+    return them as floats; ValueError starts with ``where`` and names the field (as ``names`` calls
+    it), e.g. "[specimen] friction_angle_deg must be ..."."""
+    out: dict[str, float | None] = {}
+    for name, value in values.items():
+        required, test, what = _CHECKS[name]
+        label = (names or {}).get(name, name)
+        if value is None and not required:
+            out[name] = None
+            continue
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value) or not test(value):
+            raise ValueError(f"{where} {label} must be {what}, got {value!r}")
+        out[name] = float(value)
+    return out
 
 
 @dataclass(frozen=True)
@@ -49,6 +91,12 @@ class JointMaterial:
     residual_cohesion: float = 0.0
     beta: float | None = None
 
+    def __post_init__(self) -> None:
+        # every path (builders, case files, ``builder.default_material``) gets a checked material;
+        # NaN or a zero stiffness would otherwise stall the run at t = 0
+        for name, value in check_material({f.name: getattr(self, f.name) for f in fields(self)}, "JointMaterial:").items():
+            object.__setattr__(self, name, value)
+
     @classmethod
     def from_modulus(
         cls, youngs_modulus: float, joint_spacing: float, *, poisson: float = 0.25, **kwargs: float
@@ -69,26 +117,7 @@ class JointMaterial:
 
     def validate(self, where: str) -> None:
         """Raise ValueError naming ``where`` and the field for any non-physical value."""
-        checks = [
-            ("kn", self.kn, self.kn is not None and self.kn > 0, "a positive stiffness per area [Pa/m]"),
-            ("ks", self.ks, self.ks is None or self.ks > 0, "a positive stiffness per area [Pa/m]"),
-            ("friction_angle", self.friction_angle, 0 <= self.friction_angle < 90, "an angle in [0, 90) degrees"),
-            ("cohesion", self.cohesion, self.cohesion >= 0, "a non-negative stress [Pa]"),
-            ("tension", self.tension, self.tension >= 0, "a non-negative stress [Pa]"),
-            ("residual_cohesion", self.residual_cohesion, self.residual_cohesion >= 0, "a non-negative stress [Pa]"),
-            (
-                "residual_friction_angle",
-                self.residual_friction_angle,
-                self.residual_friction_angle is None or 0 <= self.residual_friction_angle < 90,
-                "an angle in [0, 90) degrees",
-            ),
-            ("beta", self.beta, self.beta is None or self.beta >= 0, "a non-negative time [s]"),
-        ]
-        for field, value, ok, what in checks:
-            if value is not None and not math.isfinite(value):
-                ok = False
-            if not ok:
-                raise ValueError(f"{where}: {field} must be {what}, got {value!r}")
+        check_material({f.name: getattr(self, f.name) for f in fields(self)}, f"{where}:")
 
     @property
     def tan_friction(self) -> float:

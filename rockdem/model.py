@@ -15,10 +15,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .flatten import BlockFrame, flatten_geometry
-from .geometry import Polyhedron, box, mass_properties
+from .geometry import MAX_FACE_POINTS, Polyhedron, box, mass_properties
 from .kernels.layout import ModelArrays
 from .kernels.rotation import axis_angle_matrix, matrix_to_quat
-from .materials import JointMaterial
+from .materials import JointMaterial, real_number
 
 __all__ = ["Motion", "Damping", "ModelBuilder", "Model", "GROUND"]
 
@@ -39,8 +39,8 @@ class Motion:
     velocity: NDArray[np.float64]
 
     def __post_init__(self) -> None:
-        t = np.asarray(self.time, dtype=float).reshape(-1)
-        v = np.asarray(self.velocity, dtype=float)
+        t = _float_array(self.time, "Motion: time [s]").reshape(-1)
+        v = _float_array(self.velocity, "Motion: velocity [m/s]")
         if v.ndim == 1:
             v = v.reshape(-1, 1) * np.array([[1.0, 0.0, 0.0]]) if v.shape[0] == t.shape[0] else v.reshape(1, 3)
         if t.shape[0] < 1 or v.shape != (t.shape[0], 3):
@@ -55,7 +55,11 @@ class Motion:
     @classmethod
     def constant(cls, velocity: ArrayLike, *, start: float = 0.0, stop: float | None = None) -> "Motion":
         """Constant velocity [m/s] from ``start`` to ``stop`` [s] (at rest outside)."""
-        v = np.asarray(velocity, dtype=float).reshape(3)
+        v = _vector3(velocity, "Motion.constant: velocity [m/s]")
+        if not real_number(start, "Motion.constant: start [s]") >= 0.0:
+            raise ValueError(f"Motion.constant: start must be a time >= 0 [s], got {start!r}")
+        if stop is not None and not real_number(stop, "Motion.constant: stop [s]") > start:
+            raise ValueError(f"Motion.constant: stop must come after start ({start} s), got {stop!r}")
         eps = 1e-9
         if stop is None:
             t = [0.0, start, start + eps] if start > 0 else [0.0]
@@ -70,13 +74,22 @@ class Motion:
     @classmethod
     def from_function(cls, func: Callable[[float], ArrayLike], duration: float, sample_dt: float = 1e-4) -> "Motion":
         """Sample a velocity function v(t) -> (3,) [m/s] every ``sample_dt`` over [0, duration] [s]."""
+        if not real_number(duration, "Motion.from_function: duration [s]") > 0:
+            raise ValueError(f"Motion.from_function: duration must be positive [s], got {duration!r}")
+        if not real_number(sample_dt, "Motion.from_function: sample_dt [s]") > 0:
+            raise ValueError(f"Motion.from_function: sample_dt must be positive [s], got {sample_dt!r}")
+        if duration / sample_dt > MAX_MOTION_SAMPLES:
+            raise ValueError(
+                f"Motion.from_function: {duration / sample_dt:.3g} samples (duration / sample_dt) exceed "
+                f"{MAX_MOTION_SAMPLES}; raise sample_dt"
+            )
         t = np.arange(0.0, duration + sample_dt, sample_dt)
         return cls(t, np.array([np.asarray(func(ti), dtype=float).reshape(3) for ti in t]))
 
 
 @dataclass(frozen=True)
 class Damping:
-    """Rayleigh and local damping (paper Eq. 4; DESIGN §2).
+    """Rayleigh damping (paper §3, Eq. 4) and Cundall's local damping (quasi-static runs only).
 
     Attributes:
         alpha: mass-proportional coefficient [1/s]: force -alpha m v, moment -alpha I omega.
@@ -92,11 +105,17 @@ class Damping:
     alpha_relative: bool = False
     local: float = 0.0
 
+    def __post_init__(self) -> None:
+        self.validate()
+
     def validate(self) -> None:
+        """Raise ValueError naming the field for a negative, non-finite or non-numeric value."""
         for name in ("alpha", "beta", "local"):
             v = getattr(self, name)
-            if not (math.isfinite(v) and v >= 0.0):
+            if not real_number(v, f"damping.{name}") >= 0.0:
                 raise ValueError(f"damping.{name} must be a finite non-negative number, got {v!r}")
+        if not isinstance(self.alpha_relative, (bool, np.bool_)):
+            raise ValueError(f"damping.alpha_relative must be True or False, got {self.alpha_relative!r}")
         if self.local >= 1.0:
             raise ValueError(f"damping.local must be below 1 (0.8 is usual for quasi-static runs), got {self.local!r}")
 
@@ -190,16 +209,24 @@ class ModelBuilder:
     """
 
     def __init__(self, *, gravity: ArrayLike = (0.0, 0.0, -9.81), points: tuple[int, int] = (2, 2)) -> None:
-        g = np.asarray(gravity, dtype=float).reshape(3)
-        if not np.all(np.isfinite(g)):
-            raise ValueError(f"gravity must be a finite 3-vector [m/s^2], got {gravity!r}")
-        self.gravity = g
+        self.gravity = _vector3(gravity, "gravity [m/s^2]")
         self.points = _check_points(points, "builder points")
         self._blocks: list[_Block] = []
         self._materials: dict[frozenset[str], JointMaterial] = {}
-        self.default_material: JointMaterial | None = None
+        self._default_material: JointMaterial | None = None
         self.ground_motion: Motion | None = None
         self.body_acceleration: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    @property
+    def default_material(self) -> JointMaterial | None:
+        """Joint material of every group pair without its own :meth:`set_material` (None: none)."""
+        return self._default_material
+
+    @default_material.setter
+    def default_material(self, material: JointMaterial | None) -> None:
+        if material is not None and not isinstance(material, JointMaterial):
+            raise ValueError(f"default_material must be a JointMaterial (or None), got {material!r}")
+        self._default_material = material
 
     # -- blocks -------------------------------------------------------------------------------
     def add_block(
@@ -228,11 +255,15 @@ class ModelBuilder:
         """
         i = len(self._blocks)
         name = f"block{i}" if name is None else str(name)
+        if not isinstance(poly, Polyhedron):
+            raise ValueError(f"block {name!r}: poly must be a Polyhedron (rockdem.geometry.box or convex_hull), got {poly!r}")
         if any(b.name == name for b in self._blocks):
             raise ValueError(f"block name {name!r} is used twice; give each block a unique name")
-        if not (math.isfinite(density) and density > 0.0):
+        if isinstance(density, bool) or not isinstance(density, (int, float, np.number)) or not (math.isfinite(density) and density > 0.0):
             raise ValueError(f"block {name!r}: density must be positive [kg/m^3], got {density!r}")
-        if not (driven is False or driven is True or driven == GROUND or isinstance(driven, Motion)):
+        if not isinstance(group, str) or not group:
+            raise ValueError(f"block {name!r}: group must be a non-empty name (a string), got {group!r}")
+        if not (driven is False or driven is True or isinstance(driven, Motion) or (isinstance(driven, str) and driven == GROUND)):
             raise ValueError(f"block {name!r}: driven must be False, True, 'ground' or a Motion, got {driven!r}")
         pts = self.points if points is None else _check_points(points, f"block {name!r} points")
         self._blocks.append(
@@ -240,11 +271,11 @@ class ModelBuilder:
                 name,
                 poly,
                 float(density),
-                str(group),
+                group,
                 driven,
                 pts,
-                np.asarray(velocity, dtype=float).reshape(3),
-                np.asarray(angular_velocity, dtype=float).reshape(3),
+                _vector3(velocity, f"block {name!r}: velocity [m/s]"),
+                _vector3(angular_velocity, f"block {name!r}: angular_velocity [rad/s]"),
             )
         )
         return i
@@ -259,9 +290,10 @@ class ModelBuilder:
         **kwargs: object,
     ) -> int:
         """Add a box of width b (x), length l (y), height h (z) [m] whose base centre is ``base_center``."""
-        c = np.asarray(base_center, dtype=float) + np.array([0.0, 0.0, 0.5 * h])
-        name = kwargs.get("name")
-        return self.add_block(box(b, l, h, center=c, name=str(name or "box")), **kwargs)  # type: ignore[arg-type]
+        name = str(kwargs.get("name") or "box")
+        hh = real_number(h, f"{name}: h (height, z) [m]")
+        c = _vector3(base_center, f"{name}: base_center [m]") + np.array([0.0, 0.0, 0.5 * hh])
+        return self.add_block(box(b, l, h, center=c, name=name), **kwargs)  # type: ignore[arg-type]
 
     def block(self, i: int | str) -> Polyhedron:
         """Current geometry of block ``i`` (id or name)."""
@@ -320,7 +352,13 @@ class ModelBuilder:
         discretised wall is released exactly as the equivalent single block. Returns the tilt
         angle [rad].
         """
-        ids = [self._index(i)] if isinstance(i, (str, int, np.integer)) else [self._index(k) for k in i]
+        try:
+            ids = [self._index(i)] if isinstance(i, (str, int, np.integer)) else [self._index(k) for k in i]
+        except (KeyError, IndexError, TypeError) as exc:
+            raise ValueError(
+                f"tilt: give a block name or id, or a list of them (blocks are {self.block_names()[:10]}), got {i!r}: "
+                f"{exc.args[0] if exc.args else exc}"
+            ) from None
         if not ids:
             raise ValueError("tilt: give at least one block")
         if len(set(ids)) != len(ids):
@@ -329,9 +367,9 @@ class ModelBuilder:
         driven = [b.name for b in blocks if b.driven is not False]
         if driven:
             raise ValueError(f"tilt: blocks {driven} are driven; only free blocks can be tilted")
-        if not (isinstance(fraction, (int, float)) and math.isfinite(fraction) and 0.0 <= fraction):
+        if isinstance(fraction, bool) or not (isinstance(fraction, (int, float)) and math.isfinite(fraction) and 0.0 <= fraction):
             raise ValueError(f"tilt fraction must be >= 0 (0.9 = 90 % of the instability angle), got {fraction!r}")
-        d = np.asarray(direction, dtype=float).reshape(3)
+        d = _vector3(direction, "tilt direction")
         gn = np.linalg.norm(self.gravity)
         up = -self.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
         d = d - up * (up @ d)
@@ -350,6 +388,11 @@ class ModelBuilder:
         rel = c - pivot
         eta = math.atan2(max(float(-(rel @ d)), 0.0), float(rel @ up))
         theta = fraction * eta
+        if not theta < 0.5 * math.pi:
+            raise ValueError(
+                f"tilt fraction {fraction!r} of the instability angle ({math.degrees(eta):.3g} deg) tilts the blocks "
+                "by 90 deg or more; give a fraction below 1 for a release from rest (paper §3.1)"
+            )
         r = axis_angle_matrix(np.cross(up, d), theta)
         for k, blk in zip(ids, blocks):
             if blk.reference is None:
@@ -361,19 +404,29 @@ class ModelBuilder:
     # -- materials and loading ----------------------------------------------------------------
     def set_material(self, group_a: str, group_b: str, material: JointMaterial) -> None:
         """Joint material between groups ``group_a`` and ``group_b`` (order irrelevant)."""
+        if not (isinstance(group_a, str) and isinstance(group_b, str)):
+            raise ValueError(f"set_material: groups are names (strings), got {group_a!r} and {group_b!r} (material)")
+        if not isinstance(material, JointMaterial):
+            raise ValueError(f"set_material {group_a!r}-{group_b!r}: material must be a JointMaterial, got {material!r}")
         material.validate(f"material {group_a!r}-{group_b!r}")
         self._materials[frozenset((group_a, group_b))] = material
 
     def set_ground_motion(self, motion: Motion | None) -> None:
         """Velocity history of every block added with ``driven="ground"``."""
+        if motion is not None and not isinstance(motion, Motion):
+            raise ValueError(f"set_ground_motion: give a Motion (velocity history) or None, got {motion!r}")
         self.ground_motion = motion
 
     def set_body_acceleration(self, time: ArrayLike, acceleration: ArrayLike) -> None:
         """Acceleration history a(t) (n, 3) [m/s^2] applied as body force m a(t) on every free block."""
-        t = np.asarray(time, dtype=float).reshape(-1)
-        a = np.asarray(acceleration, dtype=float).reshape(t.shape[0], 3)
-        if np.any(np.diff(t) <= 0) or not (np.all(np.isfinite(t)) and np.all(np.isfinite(a))):
-            raise ValueError("body acceleration: times must increase and values be finite")
+        t = _float_array(time, "body acceleration: time [s]").reshape(-1)
+        a = _float_array(acceleration, "body acceleration: acceleration [m/s^2]")
+        if a.shape != (t.shape[0], 3) or t.shape[0] < 1:
+            raise ValueError(f"body acceleration: time (n,) and acceleration (n, 3) must match, got {t.shape} and {a.shape}")
+        if np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
+            raise ValueError("body acceleration: time samples must be finite and strictly increasing")
+        if not np.all(np.isfinite(a)):
+            raise ValueError("body acceleration: acceleration values must be finite")
         self.body_acceleration = (t, a)
 
     # -- freeze -------------------------------------------------------------------------------
@@ -558,6 +611,10 @@ class ModelBuilder:
         return i
 
 
+MAX_MOTION_SAMPLES = 10_000_000
+"""Most samples of a prescribed motion built by :meth:`Motion.from_function`."""
+
+
 def _extent(vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
     """The model's extent: the bounding box of every block at the start, enlarged on each side by
     its largest dimension (at least 1 m). A free block whose centroid leaves it has fallen through
@@ -572,10 +629,29 @@ def _extent(vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: N
 
 
 def _check_points(points: Sequence[int], what: str) -> tuple[int, int]:
-    try:
-        a, b = (int(points[0]), int(points[1]))
-    except (TypeError, ValueError, IndexError):
-        raise ValueError(f"{what}: give (across, along) interface point counts, got {points!r}") from None
-    if a < 1 or b < 1 or a != points[0] or b != points[1]:
+    if isinstance(points, (str, bytes)) or not hasattr(points, "__len__") or len(points) != 2:
+        raise ValueError(f"{what}: give (across, along) interface point counts, got {points!r}")
+    if any(isinstance(p, bool) or not isinstance(p, (int, np.integer)) or p < 1 for p in points):
         raise ValueError(f"{what}: counts must be integers >= 1 (the paper uses 2..15 across), got {points!r}")
+    a, b = int(points[0]), int(points[1])
+    if a * b > MAX_FACE_POINTS:
+        raise ValueError(f"{what}: {a} x {b} points per face exceed the limit of {MAX_FACE_POINTS} (the paper uses 2..15 across)")
     return a, b
+
+
+def _float_array(value: ArrayLike, what: str) -> NDArray[np.float64]:
+    """``value`` as a float array, or ValueError naming ``what``."""
+    if isinstance(value, (str, bytes)) or value is None:
+        raise ValueError(f"{what} must be numbers, got {value!r}")
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be numbers, got {value!r}") from None
+
+
+def _vector3(value: ArrayLike, what: str) -> NDArray[np.float64]:
+    """A finite 3-vector, or ValueError naming ``what``."""
+    v = _float_array(value, what)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{what} must be a finite 3-vector (x, y, z), got {value!r}")
+    return v

@@ -27,7 +27,7 @@ import xarray as xr
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 
-from .analysis import apparent_restitution, bouncing, half_cycle_peaks, lowest_point_height, wme
+from .analysis import apparent_restitution, bouncing, half_cycle_peaks, lowest_point_height, result_eta, wme
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices
 
 __all__ = [
@@ -37,6 +37,7 @@ __all__ = [
     "rocking_direction",
     "block_dimensions",
     "top_displacement",
+    "ground_displacement",
     "world_vertices",
     "plot_history",
     "plot_restitution",
@@ -45,6 +46,8 @@ __all__ = [
     "plot_capacity",
     "plot_contacts",
     "plot_comparison",
+    "is_pushover",
+    "is_free_rocking",
     "read_history_csv",
     "save_figure",
     "register_cli",
@@ -175,17 +178,19 @@ def world_vertices(ds: xr.Dataset, frames: int | Sequence[int] | slice, block: i
 
 
 def top_displacement(ds: xr.Dataset, monitor: str | None = None) -> tuple[np.ndarray, str]:
-    """Horizontal top displacement along the rocking direction [m] and a label saying its source.
+    """Horizontal top displacement along the rocking direction [m], relative to the ground, and a
+    label saying its source.
 
-    A recorded monitor is used when there is one (its displacement from the reference, untilted
-    position); otherwise the highest vertex of the free blocks, measured from its t = 0 position.
+    A recorded monitor is used when there is one (``monitor_displacement``: from the reference,
+    untilted position, relative to the ground); otherwise the highest vertex of the free blocks,
+    measured from its t = 0 position minus the ground's displacement.
     """
     d = rocking_direction(ds)
-    base, base_name = _foundation_motion(ds)
-    rel = f", relative to {base_name}" if base_name else ""
+    base = ground_displacement(ds)
+    rel = ", relative to the ground" if np.any(base != 0.0) else ""
     k = _monitor(ds, monitor)
     if k is not None:
-        return (ds.monitor_displacement.values[:, k] - base) @ d, f"monitor {ds.monitor.values[k]!s}{rel}"
+        return ds.monitor_displacement.values[:, k] @ d, f"monitor {ds.monitor.values[k]!s}{rel}"
     free = np.flatnonzero(ds.block_free.values)
     if free.size == 0:
         raise ValueError("monitor: the result has no monitor and no free block")
@@ -199,24 +204,18 @@ def top_displacement(ds: xr.Dataset, monitor: str | None = None) -> tuple[np.nda
     return (path - path[0] - base) @ d, f"highest vertex, from t = 0{rel}"
 
 
-def _foundation_motion(ds: xr.Dataset) -> tuple[np.ndarray, str]:
-    """Displacement (T, 3) [m] of the foundation (the lowest driven block) and its name; zeros and
-    "" when there is none or it does not move (top displacements are then absolute)."""
-    driven = np.flatnonzero(~ds.block_free.values)
-    zero = np.zeros((ds.sizes["time"], 3))
-    if driven.size == 0:
-        return zero, ""
-    f = int(driven[np.argmin(ds.block_position.values[0, driven, 2])])
-    u = ds.block_displacement.values[:, f]
-    if not np.any(np.abs(u) > 1e-12):
-        return zero, ""
-    return u, f"foundation {ds.block_name.values[f]!s}"
+def ground_displacement(ds: xr.Dataset) -> np.ndarray:
+    """Displacement (T, 3) [m] of the ground (the driven="ground" blocks); zeros when the result
+    has none (no ground motion, or a result without ``ground_displacement``)."""
+    if "ground_displacement" in ds:
+        return np.asarray(ds.ground_displacement.values, dtype=float)
+    return np.zeros((ds.sizes["time"], 3))
 
 
-def _weight(ds: xr.Dataset) -> float:
-    free = ds.block_free.values
-    g = float(np.linalg.norm(ds.attrs.get("gravity", (0.0, 0.0, -9.81))))
-    return float(np.sum(ds.block_mass.values[free])) * g
+def _block_label(ds: xr.Dataset, b: int) -> str:
+    """'block NAME', or just NAME when it already says block (no "block block")."""
+    name = str(ds.block_name.values[b])
+    return name if "block" in name.lower() else f"block {name}"
 
 
 # -- plots --------------------------------------------------------------------------------------
@@ -240,8 +239,8 @@ def plot_history(
     fig = Figure(figsize=(_WIDTH, 4.6))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(t, ds.rocking_angle.values[:, b], color="C0")
-    ax1.set_ylabel("rotation θ [rad]")
-    ax1.set_title(f"{_label(ds, 'result')}: block {ds.block_name.values[b]!s}")
+    ax1.set_ylabel("rocking angle θ [rad]")
+    ax1.set_title(f"{_label(ds, 'result')}: {_block_label(ds, b)}")
     ax2.plot(t, u / bw, color="C1")
     ax2.set_ylabel("top displacement u/B [-]")
     ax2.set_xlabel("time [s]")
@@ -256,7 +255,9 @@ def plot_restitution(result: Result, *, block: int | str | None = None, min_frac
     """Half-cycle peaks |theta_n| and apparent restitution e_a per impact (Eq. 6, Figs. 6D-F, 8C-D).
 
     The Housner value e_eta = 1 - 1.5 sin^2(eta) and 0.95 e_eta are drawn for reference, with
-    eta = atan(B/H) of the block (B, H from :func:`block_dimensions`). Peaks and e_a come from
+    eta the instability angle about the pivot the block rocks on (:func:`rockdem.analysis.result_eta`:
+    the base contact face, so a reduced parapet base counts; the assembly's for a released
+    assembly), else atan(B/H) of :func:`block_dimensions`. Peaks and e_a come from
     :func:`rockdem.analysis.half_cycle_peaks` and :func:`rockdem.analysis.apparent_restitution`.
 
     Args:
@@ -266,8 +267,9 @@ def plot_restitution(result: Result, *, block: int | str | None = None, min_frac
     """
     ds = load_result(result)
     b = _block(ds, block)
-    bw, h = block_dimensions(ds, b)
-    eta = float(np.arctan2(bw, h))
+    eta = result_eta(ds, b)
+    if eta is None:
+        eta = float(np.arctan2(*block_dimensions(ds, b)))
     e_eta = 1.0 - 1.5 * np.sin(eta) ** 2
     t, theta = ds.time.values, ds.rocking_angle.values[:, b]
     amp = float(np.max(np.abs(theta), initial=0.0))
@@ -286,7 +288,7 @@ def plot_restitution(result: Result, *, block: int | str | None = None, min_frac
     ax1.plot(tp, peaks / eta, "o", color="C0", ms=4, label="peaks |θ_n|/η")
     ax1.set_xlabel("time [s]")
     ax1.set_ylabel("|θ| / η [-]")
-    ax1.set_title(f"block {ds.block_name.values[b]!s}, η = {np.degrees(eta):.1f}°")
+    ax1.set_title(f"{_block_label(ds, b)}, η = {eta:.4f} rad")
     ax1.legend(loc="upper right")
     n = np.arange(1, ea.size + 1)
     ax2.plot(n, ea, "o-", color="C0", ms=4, label="e_a (Eq. 6)")
@@ -314,11 +316,12 @@ def plot_bouncing(result: Result, *, block: int | str | None = None, gap: float 
     t = ds.time.values
     uz = ds.block_displacement.values[:, b, 2]
     low = lowest_point_height(ds, b)
-    base, _ = _foundation_motion(ds)
+    base = ground_displacement(ds)
     bo = bouncing(t, low, z_contact=low[0] + base[:, 2], tol=gap)
     fig = Figure(figsize=(_WIDTH, 3.4))
     ax = fig.subplots()
-    ax.plot(t, uz * 1e3, color="C0", label="centroid u_z")
+    rel = " (relative to the ground)" if ds.block_displacement.attrs.get("reference") == "ground" else ""
+    ax.plot(t, uz * 1e3, color="C0", label=f"centroid u_z{rel}")
     for k, (t0, dur) in enumerate(zip(bo.start, bo.duration)):
         ax.axvspan(t0, t0 + dur, color="C3", alpha=0.25, lw=0, label="airborne" if k == 0 else None)
     ax.set_xlabel("time [s]")
@@ -328,7 +331,7 @@ def plot_bouncing(result: Result, *, block: int | str | None = None, gap: float 
         if bo.start.size
         else "no airborne phase"
     )
-    ax.set_title(f"block {ds.block_name.values[b]!s}: {text} (gap {gap * 1e3:.3g} mm)")
+    ax.set_title(f"{_block_label(ds, b)}: {text} (gap {gap * 1e3:.3g} mm)")
     ax.legend(loc="upper right")
     fig.tight_layout()
     return fig
@@ -374,11 +377,26 @@ def plot_energy(result: Result) -> Figure:
     return fig
 
 
-def _capacity_force(ds: xr.Dataset) -> tuple[np.ndarray, str]:
+def is_pushover(ds: xr.Dataset) -> bool:
+    """Whether a result is a pushover (a ``load_factor`` variable or the ``pushover_*`` attributes
+    that :func:`rockdem.loading.pushover` and the TOML pushover loadings write)."""
+    return "load_factor" in ds or any(str(k).startswith("pushover_") for k in ds.attrs)
+
+
+def _capacity_force(ds: xr.Dataset, monitor: str | None) -> tuple[np.ndarray, str]:
+    """Load factor (T,) [-] of a pushover and its axis label."""
     if "load_factor" in ds:
         return ds.load_factor.values, "load factor [-]"
-    shear = -ds.base_reaction.values @ rocking_direction(ds)
-    return shear / _weight(ds), "base shear / weight [-]"
+    if not is_pushover(ds):
+        raise ValueError(f"capacity: {_label(ds, 'the result')} is not a pushover (no pushover_* attributes); "
+                         "capacity curves apply to pushover results ([loading] type = \"pushover\")")
+    from .loading import capacity_curve
+
+    names = [str(n) for n in ds.monitor.values] if "monitor" in ds.coords else []
+    lam, _ = capacity_curve(ds, monitor or (names[0] if names else "top"))
+    if ds.attrs.get("pushover_rod") is not None:
+        return lam, "load factor: rod force / weight [-]"
+    return lam, "load factor λ [-]"
 
 
 @_styled
@@ -387,22 +405,25 @@ def plot_capacity(
 ) -> Figure:
     """Capacity curves of pushovers (Fig. 9A): load factor vs top displacement [mm].
 
-    The load factor is the result's ``load_factor`` variable when present, otherwise the
-    horizontal base shear along the rocking direction divided by the weight of the free blocks
-    (equal to the lateral load factor of a quasi-static body-force pushover).
+    The load factor is the result's ``load_factor`` variable when present, otherwise
+    :func:`rockdem.loading.capacity_curve`'s: the pushing rod's force over the weight of the free
+    blocks (displacement control), or the applied ramp lambda(t) (load control).
+
+    Raises:
+        ValueError: a result is not a pushover.
     """
     items = _as_list(results)
     labels = _labels(items, labels)
     fig = Figure(figsize=(_WIDTH, 4.0))
     ax = fig.subplots()
-    ylabel = ""
+    ylabel = src = ""
     for ds, lab in zip(items, labels):
         u, src = top_displacement(ds, monitor)
-        y, ylabel = _capacity_force(ds)
+        y, ylabel = _capacity_force(ds, monitor)
         ax.plot(u * 1e3, y, label=lab)
     ax.set_xlabel(f"top displacement [mm] ({src})")
     ax.set_ylabel(ylabel)
-    ax.set_title("capacity curve")
+    ax.set_title("capacity curve" + ("s" if len(items) > 1 else ""))
     ax.legend(loc="best")
     fig.tight_layout()
     return fig
@@ -552,21 +573,58 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: float | None = None) -> P
 
 
 # -- CLI ----------------------------------------------------------------------------------------
+def is_free_rocking(ds: xr.Dataset) -> bool:
+    """Whether a result is a free-rocking run: released from a tilt (attrs ``tilt_angle_rad`` or a
+    non-zero rocking angle at t = 0), with no earthquake and no pushover."""
+    if is_pushover(ds) or "earthquake_mode" in ds.attrs or np.any(ground_displacement(ds) != 0.0):
+        return False
+    free = np.flatnonzero(ds.block_free.values)
+    return "tilt_angle_rad" in ds.attrs or bool(np.any(ds.rocking_angle.values[0, free] != 0.0))
+
+
+def _not_applicable(kind: str, items: Sequence[xr.Dataset], measured: object) -> str:
+    """Why a plot kind does not apply to these results ("" when it does)."""
+    first = items[0]
+    if kind == "capacity" and not all(is_pushover(ds) for ds in items):
+        return "not a pushover result"
+    if kind == "restitution" and not is_free_rocking(first):
+        return "not a free-rocking run; e_a (Eq. 6) measures the decay of rocking released from rest"
+    if kind == "bouncing" and is_pushover(first):
+        return "a quasi-static pushover has no impacts"
+    if kind == "comparison" and len(items) < 2 and measured is None:
+        return "one result and no --measured history: nothing to compare"
+    return ""
+
+
+def _file_label(path: Path) -> str:
+    """A result's name from its file: the folder for the usual ``<folder>/result.nc``."""
+    return path.resolve().parent.name if path.stem == "result" else path.stem
+
+
 def _plot(args: argparse.Namespace) -> int:
     kinds = list(PLOTS) if args.kind == "all" else [args.kind]
     multi = {"capacity", "comparison"}
     first = Path(args.results[0])
     if len(args.results) > 1 and not set(kinds) & multi:
         raise ValueError(f"--kind {args.kind} draws one result; give one RESULT or use --kind comparison/capacity")
-    written = []
+    loaded = [load_result(r) for r in args.results]
+    for ds, r in zip(loaded, args.results):
+        ds.attrs.setdefault("name", _file_label(Path(r)))
+    written, skipped = [], []
     for kind in kinds:
+        why = _not_applicable(kind, loaded if kind in multi else loaded[:1], args.measured)
+        if why and args.kind == "all":
+            skipped.append(f"{kind}: {why}")
+            continue
+        if why and kind == "capacity":
+            raise ValueError(f"--kind capacity: {why}; capacity curves apply to pushover results")
         func = PLOTS[kind]
         kw: dict[str, object] = {}
         if kind in multi:
-            kw["labels"] = args.labels or [Path(r).stem for r in args.results]
-            target: object = args.results
+            kw["labels"] = args.labels or [_file_label(Path(r)) for r in args.results]
+            target: object = loaded
         else:
-            target = args.results[0]
+            target = loaded[0]
         if kind in ("history", "restitution", "bouncing") and args.block is not None:
             kw["block"] = args.block
         if kind in ("history", "capacity", "comparison") and args.monitor is not None:
@@ -586,6 +644,8 @@ def _plot(args: argparse.Namespace) -> int:
         written.append(save_figure(fig, out, dpi=args.dpi))
     for p in written:
         print(f"rockdem plot: wrote {p}")
+    for note in skipped:
+        print(f"rockdem plot: skipped {note}")
     return 0
 
 

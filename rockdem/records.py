@@ -5,14 +5,27 @@ PEER NGA AT2 (NGA-West2 and older PEER headers, the "Peknold" 8F10.5 variant), t
 time/acceleration text or CSV files, and single-column files with a separately given time step.
 A :class:`GroundMotion` is immutable: processing methods (scaling, baseline correction, tail,
 resampling) return new records. Integration uses the trapezoid rule, starting from rest.
+
+Seven public records ship with the package (``rockdem/data/ground-motions``, provenance in its
+``SOURCES.md``), each with a short name (:data:`SHIPPED_RECORDS`, ``rockdem records``). A record is
+found by :func:`record_path`, in this order:
+
+1. an existing file at the given path (absolute, or relative to the working folder);
+2. a bare file name in the folder named by the environment variable ``ROCKDEM_DATA`` (or in its
+   ``ground-motions`` sub-folder), when that variable is set;
+3. a shipped record, by short name (``"elcentro-rsn6"``, any case) or by file name
+   (``"RSN6_IMPVALL.I_I-ELC180.AT2"``).
 """
 
 from __future__ import annotations
 
+import argparse
+import hashlib
 import os
 import re
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +41,15 @@ __all__ = [
     "read_columns",
     "read_single_column",
     "read_record",
-    "shared_record_path",
+    "ShippedRecord",
+    "SHIPPED_RECORDS",
+    "DATA_ENV",
+    "records_folder",
+    "shipped_record",
+    "record_path",
+    "file_sha256",
+    "record_table",
+    "register_cli",
 ]
 
 STANDARD_GRAVITY = 9.80665
@@ -114,8 +135,8 @@ def _is_numeric_line(text: str, delimiter: str | None) -> bool:
 def _read_lines(path: str | os.PathLike[str]) -> tuple[Path, list[str]]:
     p = Path(path)
     if not p.is_file():
-        raise FileNotFoundError(f"ground-motion file not found: {p} (check the path; for the shared records "
-                                "use rockdem.records.shared_record_path(name))")
+        raise FileNotFoundError(f"ground-motion file not found: {p} (check the path, or give a shipped "
+                                "record's short name: `rockdem records` lists them)")
     lines = p.read_text(encoding="utf-8", errors="replace").splitlines()
     if not any(line.strip() for line in lines):
         raise ValueError(f"{p} is empty: a ground-motion file needs at least two acceleration values")
@@ -542,19 +563,24 @@ def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
 
 def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit | None = None,
                 dt: float | None = None, format: str | RecordFormat | None = None) -> GroundMotion:
-    """Read a ground-motion file of any supported format.
+    """Read a ground-motion record of any supported format, from a file or by name.
 
     The format is ``format`` if given, else AT2 for a ``.AT2`` suffix or an NPTS/DT header line, else
     two-column time/acceleration or single-column values, from the first data line.
 
     Args:
-        path: the file.
-        units: "g", "m/s2" or "cm/s2"; optional for AT2 (header, else g), required otherwise.
+        path: a file, or a name found by :func:`record_path` (a shipped record's short name such as
+            "nahanni" or its file name, or a file name in ``$ROCKDEM_DATA``).
+        units: "g", "m/s2" or "cm/s2"; optional for AT2 (header, else g) and for shipped records
+            (their registry units), required otherwise.
         dt: time step [s]; required for single-column files, overrides the header for AT2, and for
             two-column files must agree with the time column.
         format: "at2", "columns" or "single".
     """
-    p, lines = _read_lines(path)
+    found = record_path(path)
+    if units is None and (entry := _shipped_entry(found)) is not None:
+        units = entry.units
+    p, lines = _read_lines(found)
     if format is not None and str(format).lower() not in {f.value for f in RecordFormat}:
         raise ValueError(f"{p}: unknown format {format!r}; use 'at2', 'columns' or 'single' (or omit it)")
     fmt = RecordFormat(str(format).lower()) if format is not None else _sniff_format(p, lines)
@@ -574,26 +600,278 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
     return gm
 
 
-def shared_record_path(name: str) -> Path:
-    """Path of a record in the project's shared ground-motion folder.
+# ------------------------------------------------------------------------------------- shipped records
 
-    The folder is ``$ROCKDEM_DATA/ground-motions`` or ``$ROCKDEM_DATA`` itself if the environment
-    variable is set, else ``shared/data/ground-motions`` beside the repository root.
+DATA_ENV = "ROCKDEM_DATA"
+"""Environment variable naming a folder of the user's own records (or its parent data folder)."""
+
+_PEER = "PEER NGA-West2 terms of use apply (a PEER database product)"
+_EEUQ = ("NHERI-SimCenter/EE-UQ @ 3c5339f74b86998fc68af0df7cf1b4e2ce7b1cf7; the repository's BSD-2-Clause "
+         "licence covers its source code only, not these data files")
+_IRPINIA_SOURCE = ("vacalderon/GroundmotionSelection @ 4575a07afb90e2a254291c19a0518df52a87846d (Mainshocks/, "
+                   "deleted in a later commit)")
+_IRPINIA_LICENCE = (f"PROVISIONAL: repository without licence; {_PEER}; Italian recording, redistribution terms "
+                    "not verified; header dt printed to 4 decimals only")
+
+
+@dataclass(frozen=True)
+class ShippedRecord:
+    """One ground-motion record shipped with rockdem (facts from the folder's ``SOURCES.md``).
+
+    Attributes:
+        name: short name used to refer to it (lower case, e.g. "elcentro-rsn6").
+        file: file name in the package's ``data/ground-motions`` folder.
+        event: earthquake.
+        date: its date (ISO 8601; the year only where SOURCES.md gives no more).
+        station: recording station.
+        component: horizontal component (azimuth or orientation).
+        units: units of the file's values ("g" for all shipped records).
+        sha256: SHA-256 of the file, as listed in ``SOURCES.md``.
+        source: repository (and commit) the file was copied from, byte for byte.
+        licence: what is known of its licence and terms of use.
+        provisional: True while its redistribution terms are not confirmed.
+        paper_name: the name of the closest record in Galvez et al. (2022), if any.
+    """
+
+    name: str
+    file: str
+    event: str
+    date: str
+    station: str
+    component: str
+    units: str
+    sha256: str
+    source: str
+    licence: str
+    provisional: bool = False
+    paper_name: str = ""
+
+
+SHIPPED_RECORDS: tuple[ShippedRecord, ...] = (
+    ShippedRecord(
+        name="elcentro-rsn6",
+        file="RSN6_IMPVALL.I_I-ELC180.AT2",
+        event="Imperial Valley-02",
+        date="1940-05-19",
+        station="El Centro Array #9",
+        component="180 (N-S)",
+        units="g",
+        sha256="ab219fe7bc8060fb5dba31669b5c29a782435bef113eda51ab81b8f6ff05824d",
+        source=_EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
+        licence=_PEER + "; a US federal record (USGS station 117): public domain inferred, not verified",
+        paper_name="El Centro 1940 NS",
+    ),
+    ShippedRecord(
+        name="elcentro-peknold",
+        file="elCentro.AT2",
+        event="Imperial Valley (El Centro)",
+        date="1940-05-19",
+        station="El Centro",
+        component="N-S (Peknold version)",
+        units="g",
+        sha256="e096f0458ae7565ac8e9fac80eda018e4715a357ea4c14504ce1cfa6556c53a6",
+        source=_EEUQ + " (Examples/eeuq-0001/src, last changed in 30457c6dc757084137075e893452b31ff4ba942b)",
+        licence="processing history of the Peknold version undocumented; licence as the EE-UQ note",
+        paper_name="El Centro 1940 NS",
+    ),
+    ShippedRecord(
+        name="pacoima",
+        file="RSN77_SFERN_PUL164.AT2",
+        event="San Fernando",
+        date="1971-02-09",
+        station="Pacoima Dam (upper left abut.)",
+        component="164",
+        units="g",
+        sha256="ea1186e852208172b90d20416fb18e9a9683881ed49fff92299982d73f131b16",
+        source=_EEUQ + " (Tests/eeuq-0003/templatedir, added in c3e5482d382b062f5bfd1ecd86e376bfa516f229)",
+        licence=_PEER + "; a California state record (CDMG station 279): public domain not verified",
+        paper_name="Pacoima Dam 1971",
+    ),
+    ShippedRecord(
+        name="nahanni",
+        file="Nahanni_1985_NS1-280.csv",
+        event="Nahanni, Canada",
+        date="1985",
+        station="Site 1",
+        component="280",
+        units="g",
+        sha256="0775c99a96c957a87bfded82e89a5da71b8cc116f98fc11b35917559f142c690",
+        source=("pySLAMMER/pySLAMMER @ dd8cfad35ab4b0a7258ff2e1b7389af0ad9d0325 (src/pyslammer/sample_ground_motions, "
+                "last changed in 4c622266be28eca4ab05f89cf9ff0cd25244b5a1)"),
+        licence="repository GPL-3.0; recorded by the Geological Survey of Canada, whose terms were not verified",
+        paper_name="Nahanni 1985",
+    ),
+    ShippedRecord(
+        name="bagnoli",
+        file="RSN285_ITALY_A-BAG270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Bagnoli Irpinio",
+        component="270 (W-E)",
+        units="g",
+        sha256="42dee7d3b555fcbf2f0b0a66379bc8b2f4d88ba5fe1b3cebd344bf2f696bdb63",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="BagnirWE",
+    ),
+    ShippedRecord(
+        name="calitri",
+        file="RSN289_ITALY_A-CTR270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Calitri",
+        component="270 (W-E)",
+        units="g",
+        sha256="2ed09f077491311be312b67099100412865653d4e9212cd669e6a566dd2577a1",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="CalitWE",
+    ),
+    ShippedRecord(
+        name="sturno",
+        file="RSN292_ITALY_A-STU270.AT2",
+        event="Irpinia Italy-01",
+        date="1980-11-23",
+        station="Sturno (STN)",
+        component="270 (W-E)",
+        units="g",
+        sha256="f5c3bd51b15a75b6dfc902ea40e49fe0b7f733e08eb270b20020eb2224c478a0",
+        source=_IRPINIA_SOURCE,
+        licence=_IRPINIA_LICENCE,
+        provisional=True,
+        paper_name="SturWE",
+    ),
+)
+"""The records shipped in ``rockdem/data/ground-motions`` (details in that folder's SOURCES.md)."""
+
+
+def records_folder() -> Path:
+    """Folder of the shipped records (package data, installed with rockdem)."""
+    return Path(str(resources.files("rockdem").joinpath("data", "ground-motions")))
+
+
+def shipped_record(name: str) -> ShippedRecord | None:
+    """The shipped record with this short name (any case) or file name, or None."""
+    key = str(name).strip()
+    for rec in SHIPPED_RECORDS:
+        if key.lower() == rec.name or key == rec.file:
+            return rec
+    return None
+
+
+def _user_folder() -> Path | None:
+    """The ``ROCKDEM_DATA`` folder (its ``ground-motions`` sub-folder if it has one), or None if unset.
 
     Raises:
-        FileNotFoundError: folder or file missing (the message lists the files available).
+        FileNotFoundError: the variable names no folder.
     """
-    env = os.environ.get("ROCKDEM_DATA")
-    if env:
-        root = Path(env).expanduser()
-        folder = root / "ground-motions" if (root / "ground-motions").is_dir() else root
-    else:
-        folder = (Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "ground-motions").resolve()
-    if not folder.is_dir():
-        raise FileNotFoundError(f"ground-motion data folder not found: {folder}; set ROCKDEM_DATA to the "
-                                "folder holding the records (or to its parent data folder)")
-    path = folder / name
-    if not path.is_file():
-        have = ", ".join(sorted(f.name for f in folder.iterdir() if f.is_file() and f.suffix != ".md"))
-        raise FileNotFoundError(f"no record {name!r} in {folder}; available: {have}")
-    return path
+    env = os.environ.get(DATA_ENV)
+    if not env:
+        return None
+    root = Path(env).expanduser()
+    if not root.is_dir():
+        raise FileNotFoundError(f"{DATA_ENV}={env!r} is not a folder; point it at the folder holding your "
+                                f"records (or unset it to use only the shipped records)")
+    return root / "ground-motions" if (root / "ground-motions").is_dir() else root
+
+
+def record_path(name: str | os.PathLike[str]) -> Path:
+    """Find a record file (lookup order in the module docstring).
+
+    Args:
+        name: a path, a file name in ``$ROCKDEM_DATA``, or a shipped record's short or file name.
+
+    Raises:
+        FileNotFoundError: found nowhere (the message lists the shipped names and the user folder's
+            files), or ``ROCKDEM_DATA`` set to something that is not a folder.
+    """
+    p = Path(name).expanduser()
+    if p.is_file():
+        return p
+    if p.exists():
+        raise FileNotFoundError(f"record {str(name)!r} is not a file ({p} is a folder or a device)")
+    text = str(name)
+    if p.name != text or not text.strip():  # a path with a folder part: it had to exist
+        raise FileNotFoundError(f"record file not found: {p}; a folder-less name is also looked up in "
+                                f"${DATA_ENV} and among the shipped records (`rockdem records`)")
+    user = _user_folder()
+    if user is not None and (user / text).is_file():
+        return user / text
+    rec = shipped_record(text)
+    if rec is not None:
+        return records_folder() / rec.file
+    have = ", ".join(r.name for r in SHIPPED_RECORDS)
+    extra = ""
+    if user is not None:
+        own = sorted(f.name for f in user.iterdir() if f.is_file() and f.suffix.lower() != ".md")
+        extra = f"; in ${DATA_ENV} ({user}): {', '.join(own) or 'no files'}"
+    raise FileNotFoundError(f"no record {text!r}: not a file in the working folder, not a shipped record "
+                            f"(short names: {have}; `rockdem records` lists their files){extra}")
+
+
+def _shipped_entry(path: Path) -> ShippedRecord | None:
+    """The registry entry of a resolved path inside the shipped folder, else None."""
+    rec = shipped_record(path.name)
+    if rec is not None and path.resolve() == (records_folder() / rec.file).resolve():
+        return rec
+    return None
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 hex digest of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def record_table() -> list[dict[str, object]]:
+    """One row per shipped record: registry facts plus dt [s], npts, duration [s] and PGA [g]
+    read from the file itself (with :func:`read_record`)."""
+    rows: list[dict[str, object]] = []
+    for rec in SHIPPED_RECORDS:
+        gm = read_record(rec.name)
+        rows.append({"name": rec.name, "file": rec.file, "event": rec.event, "date": rec.date, "station": rec.station,
+                     "component": rec.component, "dt_s": gm.dt, "npts": gm.npts, "duration_s": gm.duration,
+                     "pga_g": gm.pga_g, "provisional": rec.provisional, "paper_name": rec.paper_name,
+                     "licence": rec.licence, "source": rec.source, "sha256": rec.sha256})
+    return rows
+
+
+def _records_cli(args: argparse.Namespace) -> int:
+    rows = record_table()
+    if args.name:
+        rec = shipped_record(args.name)
+        if rec is None:
+            raise ValueError(f"no shipped record {args.name!r}; short names: "
+                             f"{', '.join(r.name for r in SHIPPED_RECORDS)}")
+        row = next(r for r in rows if r["name"] == rec.name)
+        path = records_folder() / rec.file
+        for key, value in row.items():
+            print(f"{key:11s} {value}")
+        print(f"{'path':11s} {path}")
+        ok = file_sha256(path) == rec.sha256
+        print(f"{'checksum':11s} {'matches SOURCES.md' if ok else 'DOES NOT MATCH SOURCES.md (file altered)'}")
+        return 0 if ok else 1
+    head = ("name", "file", "event", "station", "comp.", "dt [s]", "npts", "PGA [g]", "provisional")
+    table = [[str(r["name"]), str(r["file"]), f"{r['event']} {str(r['date'])[:4]}", str(r["station"]),
+              str(r["component"]), f"{r['dt_s']:.4g}", str(r["npts"]), f"{r['pga_g']:.4f}",
+              "YES" if r["provisional"] else "no"] for r in rows]
+    widths = [max(len(h), *(len(t[k]) for t in table)) for k, h in enumerate(head)]
+    for line in (head, *table):
+        print("  ".join(f"{c:<{w}}" for c, w in zip(line, widths)).rstrip())
+    print(f"\nShipped in {records_folder()} (provenance, SHA-256 and licence notes: SOURCES.md there).")
+    print("Provisional (the three Irpinia records): licence not confirmed, do not redistribute them until "
+          "it is (re-download from PEER NGA-West2 or ITACA/ESM); their header prints dt to 4 decimals only.")
+    print(f"Refer to a record by short name or file name; a path or a file in ${DATA_ENV} takes "
+          "precedence (`rockdem records NAME` shows one record's provenance).")
+    return 0
+
+
+def register_cli(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``records`` sub-command."""
+    p = subparsers.add_parser(
+        "records", help="list the ground-motion records shipped with rockdem",
+        description="List the shipped ground-motion records (dt, npts and PGA read from the files), or "
+                    "show one record's provenance and verify its checksum.")
+    p.add_argument("name", nargs="?", help="a short name or file name: show that record's provenance")
+    p.set_defaults(func=_records_cli)

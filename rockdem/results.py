@@ -4,11 +4,17 @@ Variables (dims; units in each variable's ``units`` attribute):
   block_position (time, block, xyz) [m]        centroid
   block_quaternion (time, block, quat)         body principal frame -> world (w, x, y, z)
   block_velocity, block_angular_velocity (time, block, xyz) [m/s], [rad/s] (world)
-  block_displacement (time, block, xyz) [m]    centroid displacement from t = 0
+  block_displacement (time, block, xyz) [m]    centroid displacement from t = 0, relative to the
+                                               ground (attr ``reference``; see below)
+  block_displacement_absolute (time, block, xyz) [m]  the same in the model's fixed frame
   block_rotation (time, block, xyz) [rad]      rotation vector of R(t) R_ref^T (world); R_ref is the
                                                orientation before any initial tilt
   rocking_angle (time, block) [rad]            block_rotation . rocking_axis
-  monitor_displacement (time, monitor, xyz) [m] from the monitor's reference (untilted) position
+  monitor_displacement (time, monitor, xyz) [m] from the monitor's reference (untilted) position,
+                                               relative to the ground (attr ``reference``)
+  monitor_displacement_absolute (time, monitor, xyz) [m]  the same in the model's fixed frame
+  ground_displacement (time, xyz) [m]          displacement of the ground: the blocks added with
+                                               driven="ground" (zero without a ground motion)
   contacts_active / _bonded / _failed_tension / _failed_shear (time) [-]  sub-contact counts
   base_reaction (time, xyz) [N]                force of the driven blocks on the free blocks
   driven_reaction (time, driven_block, xyz) [N] the same, per driven block (foundation, rods, ...)
@@ -16,11 +22,23 @@ Variables (dims; units in each variable's ``units`` attribute):
   static: block_mass, block_free, block_group, block_name (block); the geometry for plots and
   VTK: vertex_local (vertex, xyz) [m] in the body frames, face_vertex (corner) global vertex ids,
   face_corner_start (face+1), block_face_start (block+1), point_count (block).
-Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, ...
+Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, displacement_reference, ...
+
+Response displacements are relative to the ground by default. Under an earthquake applied as
+foundation motion (``mode="foundation"``) the ground-following blocks move with the record's
+displacement, which can be far larger than the response (a two-block wall under Nahanni: 145 mm of
+table motion); ``block_displacement`` and ``monitor_displacement`` subtract ``ground_displacement``
+(attrs ``reference = "ground"``), and the ``*_absolute`` variables keep the motion in the model's
+fixed frame. Without a moving ground (free rocking, pushover, inertial-mode earthquakes, whose
+model frame moves with the ground) both are equal (``reference = "fixed frame"``). Rotations are
+unaffected by a translating ground. A command-line summary of peak displacements should read
+``monitor_displacement`` and print its ``reference`` attribute.
 """
 
 from __future__ import annotations
 
+import os
+import uuid
 from pathlib import Path
 from typing import Mapping
 
@@ -31,7 +49,7 @@ from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "block_eta", "save", "load", "export_csv"]
+__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv"]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -62,7 +80,19 @@ def build_dataset(
     ds["block_quaternion"] = (("time", "block", "quat"), rec.quaternion, {"units": "1"})
     ds["block_velocity"] = (xyz, rec.velocity, {"units": "m/s"})
     ds["block_angular_velocity"] = (xyz, rec.omega, {"units": "rad/s"})
-    ds["block_displacement"] = (xyz, rec.position - model.position0[None], {"units": "m"})
+    ground = ground_blocks(model)
+    u_ground = np.zeros((len(t), 3))
+    if ground.size:
+        u_ground = rec.position[:, ground[0]] - model.position0[ground[0]]  # they translate together
+    moving = bool(np.any(u_ground != 0.0))
+    ref = "ground" if moving else "fixed frame"
+    rel_note = ("relative to the ground (the blocks added with driven='ground'); absolute in the *_absolute "
+                "variable" if moving else "no moving ground: equal to the *_absolute variable")
+    abs_note = "in the model's fixed frame (inertial-mode earthquakes: a frame moving with the ground)"
+    u_abs = rec.position - model.position0[None]
+    ds["ground_displacement"] = (("time", "xyz"), u_ground, {"units": "m", "note": "driven='ground' blocks"})
+    ds["block_displacement"] = (xyz, u_abs - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
+    ds["block_displacement_absolute"] = (xyz, u_abs, {"units": "m", "reference": "fixed frame", "note": abs_note})
     ds["block_rotation"] = (xyz, rotvec, {"units": "rad"})
     ds["rocking_angle"] = (("time", "block"), rotvec @ axis, {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)
@@ -72,7 +102,9 @@ def build_dataset(
         arm = p_ref - model.position_ref[b]
         mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + rec.position[:, b] - p_ref
     ds = ds.assign_coords(monitor=np.array(names, dtype=object) if names else np.zeros(0, dtype=object))
-    ds["monitor_displacement"] = (("time", "monitor", "xyz"), mdisp, {"units": "m"})
+    mon = ("time", "monitor", "xyz")
+    ds["monitor_displacement"] = (mon, mdisp - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
+    ds["monitor_displacement_absolute"] = (mon, mdisp, {"units": "m", "reference": "fixed frame", "note": abs_note})
     for k, name in enumerate(COUNT_NAMES):
         ds[name] = ("time", rec.counts[:, k], {"units": "1"})
     ds["base_reaction"] = (("time", "xyz"), rec.reaction, {"units": "N"})
@@ -127,15 +159,26 @@ def build_dataset(
             "point_count": model.point_count,
             "contact_tolerance": m.contact_tol,
             "rockdem_version": _version(),
+            "displacement_reference": ref,
         }
     )
     return ds
 
 
+def ground_blocks(model: Model) -> np.ndarray:
+    """Ids of the driven blocks that follow the model's ground motion (``driven="ground"``)."""
+    m = model.arrays
+    if m.ground_motion < 0:
+        return np.zeros(0, dtype=np.int64)
+    return np.flatnonzero((m.block_motion == m.ground_motion) & ~m.block_free.astype(bool))
+
+
 def block_eta(model: Model) -> np.ndarray:
     """Instability (slenderness) angle of each free block about its base edges [rad], NaN for
-    driven blocks: atan(horizontal distance from the centroid to the nearer base edge along the
-    rocking direction / height of the centroid above the base), at the reference pose.
+    driven blocks, at the reference (untilted) pose: atan(horizontal distance from the centroid to
+    the nearer edge of the base contact face along the rocking direction / height of the centroid
+    above the base). The base face is the block's lowest vertices, so a reduced (chamfered) base
+    gives the angle about the pivot the block actually rocks on, as :meth:`ModelBuilder.tilt` uses.
     The rocking direction is rocking_axis x up (up opposes gravity)."""
     m = model.arrays
     g = m.gravity
@@ -148,8 +191,11 @@ def block_eta(model: Model) -> np.ndarray:
     rref = quats_to_matrices(model.quaternion_ref)
     for b in np.flatnonzero(m.block_free):
         v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref[b].T
-        height = -float(np.min(v @ up))
-        half = min(float(np.max(v @ d)), -float(np.min(v @ d)))
+        z = v @ up
+        size = float(np.ptp(v, axis=0).max())
+        base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
+        height = -float(z.min())
+        half = min(float(np.max(base @ d)), -float(np.min(base @ d)))
         if height > 0 and half > 0:
             out[b] = float(np.arctan2(half, height))
     return out
@@ -162,8 +208,19 @@ def _version() -> str:
 
 
 def save(ds: xr.Dataset, path: str | Path) -> Path:
-    """Write a result to NetCDF (compressed); returns the path."""
+    """Write a result to NetCDF (compressed); returns the path.
+
+    The file is written under a temporary name in the same folder, then renamed over ``path``: an
+    interrupted save (a second Ctrl-C, a full disk) leaves the previous file, or none, never a
+    truncated one. An existing symbolic link at ``path`` is replaced by the file, not written
+    through.
+
+    Raises:
+        ValueError: ``path`` is a folder.
+    """
     p = Path(path)
+    if p.is_dir() and not p.is_symlink():
+        raise ValueError(f"cannot save the result to {p}: it is a folder; give a file name such as {p / 'result.nc'}")
     p.parent.mkdir(parents=True, exist_ok=True)
     enc = {
         name: {"zlib": True, "complevel": 4}
@@ -177,7 +234,13 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
         if coord in out.coords:
             out = out.assign_coords({coord: out[coord].astype(str)})
     out["block_free"] = out["block_free"].astype(np.int8)
-    out.to_netcdf(p, encoding=enc)
+    tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
+    try:
+        out.to_netcdf(tmp, encoding=enc)
+        os.replace(tmp, p)  # atomic on one file system; replaces a link at p, not its target
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     return p
 
 
@@ -193,18 +256,26 @@ def load(path: str | Path) -> xr.Dataset:
 
 def export_csv(ds: xr.Dataset, path: str | Path) -> Path:
     """Histories as one CSV table: time, per-block rocking angle and displacement, monitors,
-    contact counts, base reaction and energies (one column each, units in the header)."""
+    contact counts, base reaction and energies (one column each, units in the header).
+
+    With a moving ground the displacement columns are relative to it (``top.ux rel. ground [m]``)
+    and the ground's own displacement follows (``ground.ux [m]``)."""
     cols: dict[str, np.ndarray] = {"time [s]": ds.time.values}
+    moving = ds.monitor_displacement.attrs.get("reference") == "ground"
+    rel = " rel. ground" if moving else ""
     for b in range(ds.sizes["block"]):
         if not bool(ds.block_free[b]):
             continue
         name = str(ds.block_name.values[b])
         cols[f"{name}.rocking_angle [rad]"] = ds.rocking_angle.values[:, b]
         for i, ax in enumerate("xyz"):
-            cols[f"{name}.u{ax} [m]"] = ds.block_displacement.values[:, b, i]
+            cols[f"{name}.u{ax}{rel} [m]"] = ds.block_displacement.values[:, b, i]
     for k, mname in enumerate(ds.monitor.values):
         for i, ax in enumerate("xyz"):
-            cols[f"{mname}.u{ax} [m]"] = ds.monitor_displacement.values[:, k, i]
+            cols[f"{mname}.u{ax}{rel} [m]"] = ds.monitor_displacement.values[:, k, i]
+    if moving:
+        for i, ax in enumerate("xyz"):
+            cols[f"ground.u{ax} [m]"] = ds.ground_displacement.values[:, i]
     for name in COUNT_NAMES:
         cols[f"{name} [-]"] = ds[name].values
     for i, ax in enumerate("xyz"):

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import signal
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -11,6 +13,7 @@ import numpy as np
 import xarray as xr
 
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
+from .cli import EXIT_DIVERGED, hold_signals, positive_float, stop_on_signals
 from .results import export_csv, save
 from .simulate import simulate
 
@@ -24,9 +27,12 @@ def run_case(case: Case, *, duration: float | None = None, progress: bool | None
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
     """
     r = case.run
+    dur = duration if duration is not None else r.duration
+    if r.record_interval > dur:
+        raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
     ds = simulate(
         case.model,
-        duration if duration is not None else r.duration,
+        dur,
         dt=r.dt,
         timestep_rule=r.timestep_rule,
         safety=r.safety,
@@ -42,40 +48,72 @@ def run_case(case: Case, *, duration: float | None = None, progress: bool | None
     return ds
 
 
+def _row(label: str, value: str, unit: str = "", note: str = "") -> str:
+    """One aligned summary row: label, right-aligned value, unit, note."""
+    return f"{label:<26} {value:>12}  {unit:<5} {note}".rstrip()
+
+
+# summarize_result keys -> (label, unit, format)
+_ANALYSIS_ROWS: dict[str, tuple[str, str, str]] = {
+    "max_rotation_rad": ("peak rotation", "rad", ".4g"),
+    "residual_rad": ("residual rotation", "rad", ".4g"),
+    "onset_time_s": ("rocking onset", "s", ".4g"),
+    "half_cycles": ("half cycles", "", "d"),
+    "eta_rad": ("slenderness eta", "rad", ".4g"),
+    "exceeded_eta": ("exceeded eta", "", ""),
+    "overturned": ("overturned", "", ""),
+    "e_a_mean": ("restitution e_a, mean", "", ".4g"),
+    "e_a_first": ("restitution e_a, first", "", ".4g"),
+    "bounces": ("bounces", "", "d"),
+    "bounce_max_m_s": ("largest bounce", "m/s", ".4g"),
+}
+
+
 def summary_lines(ds: xr.Dataset) -> list[str]:
-    """Human-readable summary of a result: steps, timestep, runtime, peaks, energy balance."""
+    """Human-readable summary of a result as an aligned table (quantity, value, unit, note): steps,
+    timestep, time simulated, peaks, energy balance, failed sub-contacts and the rocking analysis
+    of one block (paper Eq. 6 for e_a). Works for results of 0 or 1 frames (a run stopped at t = 0)."""
     a = ds.attrs
+    n = int(ds.sizes.get("time", 0))
     lines = [
-        f"steps            {a['steps']}",
-        f"dt               {a['dt']:.4e} s (smallest {a['dt_min']:.4e} s, rule {a['timestep_rule']})",
-        f"runtime          {a['runtime_s']:.3f} s for {float(ds.time[-1]):.3f} s simulated",
+        _row("steps", f"{int(a.get('steps', 0))}"),
+        _row("timestep", f"{a['dt']:.4e}", "s", f"smallest {a.get('dt_min', a['dt']):.4e} s, rule {a.get('timestep_rule', '?')}"),
+        _row("time simulated", f"{float(ds.time[-1]) if n else 0.0:.4f}", "s", f"{n} frames, run time {a.get('runtime_s', 0.0):.3f} s"),
     ]
     free = np.flatnonzero(ds.block_free.values)
-    theta = ds.rocking_angle.values[:, free]
-    k = int(np.argmax(np.max(np.abs(theta), axis=0)))
-    b = int(free[k])
-    lines.append(
-        f"peak rotation    {np.degrees(np.max(np.abs(theta[:, k]))):.3f} deg "
-        f"(block {ds.block_name.values[b]!s}, about axis {a['rocking_axis']})"
-    )
-    for j, name in enumerate(ds.monitor.values):
-        d = ds.monitor_displacement.values[:, j, :]
-        lines.append(f"peak |u| {name!s:8s} {np.max(np.linalg.norm(d, axis=1)) * 1e3:.2f} mm")
-    err = float(np.max(np.abs(ds.energy_balance_error_relative.values)))
-    lines.append(f"energy balance   max relative error {err:.2e}")
-    npts = max(int(a.get("point_count", 1)), 1)
-    lines.append(
-        f"sub-contacts     {int(ds.contacts_failed_shear[-1])} failed in shear "
-        f"({100 * int(ds.contacts_failed_shear[-1]) / npts:.1f} %), "
-        f"{int(ds.contacts_failed_tension[-1])} in tension "
-        f"({100 * int(ds.contacts_failed_tension[-1]) / npts:.1f} %) of {npts}"
-    )
-    if int(a.get("tilted_blocks", 0)) > 1:
-        # a released assembly (e.g. a discretised wall): analyse a block of its base course
-        z0 = ds.block_position.values[0, free, 2]
-        b = int(free[int(np.argmin(z0))])
-        lines.append(f"analysed block   {ds.block_name.values[b]!s} (base of the released assembly of {a['tilted_blocks']} blocks)")
-    lines.extend(_analysis_lines(ds, b))
+    b = peak_block = int(free[0]) if len(free) else 0
+    if n and len(free):
+        theta = np.abs(ds.rocking_angle.values[:, free])
+        k = int(np.argmax(np.max(theta, axis=0)))
+        b = peak_block = int(free[k])
+        peak = float(np.max(theta[:, k]))
+        lines.append(_row("peak rotation", f"{peak:.4g}", "rad",
+                          f"{np.degrees(peak):.3f} deg, block {str(ds.block_name.values[b])!r}, about {_axis(a)}"))
+        if "monitor_displacement" in ds and ds.sizes.get("monitor", 0):
+            ref = ds.monitor_displacement.attrs.get("reference", "")
+            note = "relative to the ground" if ref == "ground" else f"in the {ref}" if ref else ""
+            for j, name in enumerate(ds.monitor.values):
+                d = np.linalg.norm(ds.monitor_displacement.values[:, j, :], axis=1)
+                lines.append(_row(f"peak |u| at {name!s}", f"{np.max(d) * 1e3:.4g}", "mm", note))
+        if "energy_balance_error_relative" in ds:
+            err = float(np.max(np.abs(ds.energy_balance_error_relative.values)))
+            lines.append(_row("energy balance error", f"{err:.2e}", "", "largest, relative"))
+        npts = max(int(a.get("point_count", 1)), 1)
+        for mode in ("shear", "tension"):
+            var = f"contacts_failed_{mode}"
+            if var in ds:
+                failed = int(ds[var].values[-1])
+                lines.append(_row(f"failed in {mode}", f"{failed}", "", f"{100 * failed / npts:.1f} % of {npts} sub-contacts"))
+        if int(a.get("tilted_blocks", 0)) > 1:
+            # a released assembly (e.g. a discretised wall): analyse a block of its base course
+            z0 = ds.block_position.values[0, free, 2]
+            b = int(free[int(np.argmin(z0))])
+            lines.append(_row("analysed block", str(ds.block_name.values[b]), "",
+                              f"base of the released assembly of {a['tilted_blocks']} blocks"))
+        if n >= 2:
+            lines.extend(_analysis_lines(ds, b, skip=("max_rotation_rad",) if b == peak_block else ()))
+    else:
+        lines.append(_row("recorded frames", f"{n}", "", "nothing to summarise"))
     if a.get("diverged"):
         lines.append(f"DIVERGED at t = {a['diverged_time']:.4g} s: the result holds the sound frames before it")
     if a.get("interrupted"):
@@ -83,21 +121,32 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
     return lines
 
 
-def _analysis_lines(ds: xr.Dataset, block: int) -> list[str]:
-    try:
-        from .analysis import summarize_result
-    except ImportError:  # analysis module not installed in this build
-        return []
+def _axis(attrs: Any) -> str:
+    axis = np.asarray(attrs.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float).reshape(-1)
+    names = {(1.0, 0.0, 0.0): "the x axis", (0.0, 1.0, 0.0): "the y axis", (0.0, 0.0, 1.0): "the z axis"}
+    return names.get(tuple(float(v) for v in axis), f"axis {np.array2string(axis, precision=3)}")
+
+
+def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> list[str]:
+    from .analysis import summarize_result
+
     try:
         summary: dict[str, Any] = summarize_result(ds, block=block)
     except ValueError as exc:
-        return [f"analysis         skipped: {exc}"]
+        return [_row("rocking analysis", "skipped", "", str(exc))]
     out = []
     for key, value in summary.items():
-        if isinstance(value, float):
-            out.append(f"{key:16s} {value:.4g}")
-        elif isinstance(value, (bool, int, str)):
-            out.append(f"{key:16s} {value}")
+        label, unit, fmt = _ANALYSIS_ROWS.get(key, (key.replace("_", " "), "", ""))
+        if key in skip:
+            continue
+        if isinstance(value, bool):
+            out.append(_row(label, "yes" if value else "no", unit))
+        elif isinstance(value, (int, float, np.number)):
+            out.append(_row(label, format(value, fmt or ".4g") if fmt != "d" else f"{int(value)}", unit))
+        elif value is None:
+            out.append(_row(label, "-", unit, "not reached"))
+        elif isinstance(value, str):
+            out.append(_row(label, value, unit))
     return out
 
 
@@ -135,6 +184,23 @@ def plot_rocking(ds: xr.Dataset, path: Path) -> Path:
     return path
 
 
+def _output_folder(path: Path, what: str, files: tuple[str, ...]) -> Path:
+    """Create (if needed) and check the output folder before the run: it must be a writable
+    folder and none of ``files`` in it may be a folder."""
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{what} {path} is an existing file; give a folder for the results")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{what} {path}: cannot write there ({exc.strerror or exc}); choose a writable folder") from None
+    for name in files:
+        if (path / name).is_dir():
+            raise ValueError(f"{what} {path}: {name} is a folder; remove it or choose another output folder")
+    return path
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.list_examples:
         print("\n".join(example_names()))
@@ -146,31 +212,47 @@ def _run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     case = parse_case(data)
     out = Path(args.out or case.output["directory"] or Path("results") / case.name)
-    ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False)
+    files = ("result.nc", "histories.csv", "rocking.png")
+    _output_folder(out, "--out" if args.out else "[output] directory" if case.output["directory"] else "output folder", files)
+    received: list[int] = []
+    with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
+        ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False)
     wall = time.perf_counter() - t0
-    written = [save(ds, out / "result.nc")]
-    if case.output["csv"]:
-        written.append(export_csv(ds, out / "histories.csv"))
-    if case.output["plot"] and not args.no_plot:
-        written.append(plot_rocking(ds, out / "rocking.png"))
+    with hold_signals(received, "saving the results computed so far"):
+        written = [save(ds, out / "result.nc")]
+        if case.output["csv"]:
+            written.append(export_csv(ds, out / "histories.csv"))
+        if case.output["plot"] and not args.no_plot:
+            written.append(plot_rocking(ds, out / "rocking.png"))
     print(f"rockdem run: {case.name}")
     for line in summary_lines(ds):
         print("  " + line)
-    print(f"  wall time        {wall:.2f} s including set-up (and compilation on a first run)")
+    print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
-        print(f"  wrote            {p}")
-    return 130 if ds.attrs.get("interrupted") else 0
+        print("  " + _row("wrote", "", "", str(p)))
+    if received or ds.attrs.get("interrupted"):  # stopped, or interrupted while saving (the save went on)
+        return 128 + (received[0] if received else signal.SIGINT)
+    return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``run`` sub-command."""
-    p = subparsers.add_parser("run", help="run a case file or a built-in example")
+    p = subparsers.add_parser(
+        "run",
+        help="run a case file or a built-in example",
+        description="Run a TOML case file (or a built-in example), save result.nc, histories.csv and "
+        "rocking.png, and print a summary.",
+        epilog="Exit status: 0 done; 2 bad input (nothing run); 3 the run diverged (the result holds the "
+        "frames before it); 128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP): the frames "
+        "computed so far are saved. An interrupt while saving is held (the save goes on); a second one "
+        "abandons the save.",
+    )
     p.add_argument("case", nargs="?", help="TOML case file")
     p.add_argument("--example", help=f"built-in example ({', '.join(example_names())})")
     p.add_argument("--list-examples", action="store_true", help="list the built-in examples")
     p.add_argument("--out", help="output directory (default results/<case name>)")
     p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE", help="override a case value")
-    p.add_argument("--duration", type=float, help="simulated time [s], overrides [run] duration")
+    p.add_argument("--duration", type=positive_float, help="simulated time [s], overrides [run] duration")
     p.add_argument("--no-plot", action="store_true", help="do not write the PNG plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_run)

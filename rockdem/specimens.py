@@ -23,7 +23,7 @@ import numpy as np
 from .case import Table, joint_material, specimen
 from .geometry import Polyhedron, box, convex_hull, mass_properties
 from .kernels.rotation import axis_angle_matrix
-from .materials import JointMaterial
+from .materials import JointMaterial, real_number
 from .model import GROUND, Motion, ModelBuilder
 from .simulate import Monitor
 
@@ -36,9 +36,17 @@ __all__ = [
     "add_foundation",
     "rounded_prism",
     "push_motion",
+    "MAX_BLOCKS",
+    "MAX_EDGE_FACETS",
 ]
 
 Monitors = dict[str, Monitor]
+
+MAX_BLOCKS = 10_000
+"""Most blocks a specimen builder adds (the paper's discretised walls have a few hundred)."""
+
+MAX_EDGE_FACETS = 90
+"""Most flat facets of a rounded edge (90: one per degree)."""
 
 
 # -- checks and small geometry helpers ------------------------------------------------------------
@@ -54,10 +62,23 @@ def _non_negative(name: str, value: float, unit: str = "m") -> float:
     return float(value)
 
 
-def _count(name: str, value: int) -> int:
+def _count(name: str, value: int, max_: int | None = None) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    if max_ is not None and value > max_:
+        raise ValueError(f"{name} = {value} exceeds the limit of {max_}")
     return int(value)
+
+
+def _material(name: str, material: JointMaterial | None) -> JointMaterial | None:
+    if material is not None and not isinstance(material, JointMaterial):
+        raise ValueError(f"{name} must be a JointMaterial or None (the builder's default_material), got {material!r}")
+    return material
+
+
+def _block_count(what: str, count: int) -> None:
+    if count > MAX_BLOCKS:
+        raise ValueError(f"{what} gives {count} blocks, above the limit of {MAX_BLOCKS}; use larger or fewer blocks")
 
 
 def _set_pairs(builder: ModelBuilder, pairs: Sequence[tuple[str, str]], material: JointMaterial | None) -> None:
@@ -98,6 +119,13 @@ def rounded_prism(
     (or ``width - 2 chamfer``) wide. The section is centred on x = 0, spans y in
     [y0, y0 + length] (default centred on y = 0) and z in [z0, z0 + height].
     """
+    width = _positive(f"{name}: width", width)
+    length = _positive(f"{name}: length", length)
+    height = _positive(f"{name}: height", height)
+    radius = _non_negative(f"{name}: radius", radius)
+    chamfer = _non_negative(f"{name}: chamfer", chamfer)
+    z0 = real_number(z0, f"{name}: z0 [m]")
+    y0 = None if y0 is None else real_number(y0, f"{name}: y0 [m]")
     if radius > 0 and chamfer > 0:
         raise ValueError(f"{name}: give either radius or chamfer, not both")
     cut = max(radius, chamfer)
@@ -111,7 +139,7 @@ def rounded_prism(
     elif chamfer > 0:
         section = [(-hw + chamfer, 0.0), (hw - chamfer, 0.0), (hw, chamfer), (hw, height), (-hw, height), (-hw, chamfer)]
     else:
-        n = _count("edge facets", facets)
+        n = _count(f"{name}: facets", facets, MAX_EDGE_FACETS)
         ang = np.linspace(0.0, 0.5 * math.pi, n + 1)
         right = [(hw - radius + radius * math.sin(a), radius - radius * math.cos(a)) for a in ang]
         left = [(-x, z) for (x, z) in right[::-1]]
@@ -153,12 +181,12 @@ def stacked_blocks(
     """
     w = _positive("width", width)
     ln = _positive("length", length)
-    hs = [float(h) for h in heights]
-    if not hs:
-        raise ValueError("heights must list at least one block height [m]")
-    for k, h in enumerate(hs):
-        _positive(f"heights[{k}]", h)
+    if isinstance(heights, (str, bytes)) or not isinstance(heights, (Sequence, np.ndarray)) or len(heights) == 0:
+        raise ValueError(f"heights must be a non-empty list of block heights [m], got {heights!r}"[:200])
+    _block_count(f"heights ({len(heights)} entries)", len(heights))
+    hs = [_positive(f"heights[{k}]", h) for k, h in enumerate(heights)]
     _positive("density", density, "kg/m^3")
+    material = _material("material", material)
     if foundation:
         add_foundation(builder, 2.0 * max(w, ln, sum(hs)))
     _set_pairs(builder, [("block", "block"), ("block", "foundation"), ("foundation", "foundation")], material)
@@ -235,10 +263,18 @@ def brick_wall(
         _positive(nm, v)
     nc = _count("courses", courses)
     nb = _count("bricks_per_course", bricks_per_course)
+    _block_count(f"courses x bricks_per_course = {nc} x {nb}", nc * (nb + 1))
     if bond not in BONDS:
         raise ValueError(f"bond must be one of {list(BONDS)}, got {bond!r}")
     _positive("density", density, "kg/m^3")
-    if len(points) != 2 or any(isinstance(p, bool) or int(p) != p or p < 1 for p in points):
+    joint = _material("joint", joint)
+    base = _material("base", base)
+    if (
+        isinstance(points, (str, bytes))
+        or not isinstance(points, (Sequence, np.ndarray))
+        or len(points) != 2
+        or any(isinstance(p, bool) or not isinstance(p, (int, np.integer)) or p < 1 for p in points)
+    ):
         raise ValueError(f"points must be (across, along) integers >= 1, got {points!r}")
     if bond == "running" and points[1] % 2 == 0:
         raise ValueError(
@@ -331,6 +367,10 @@ def parapet(
     if not red < t:
         raise ValueError(f"base_reduction ({red} m) must be below the thickness ({t} m)")
     _positive("density", density, "kg/m^3")
+    if bond not in BONDS:
+        raise ValueError(f"bond must be one of {list(BONDS)}, got {bond!r}")
+    material = _material("material", material)
+    base_material = _material("base_material", base_material)
     if brick is not None:
         try:
             by, bz = (float(v) for v in brick)
@@ -340,6 +380,7 @@ def parapet(
         _positive("brick[1] (height, z)", bz)
         nb = max(1, round(ln / by))
         nc = max(1, round(h / bz))
+        _block_count(f"brick = ({by}, {bz}) m on a {ln} x {h} m parapet", nc * (nb + 1))
         return brick_wall(
             builder,
             brick=(t, ln / nb, h / nc),
@@ -428,13 +469,14 @@ def facade(
     if not r < 0.5 * b:
         raise ValueError(f"edge_radius ({r} m) must be below half the width ({0.5 * b} m); reduce it")
     if r > 0:
-        _count("edge_facets", edge_facets)
+        _count("edge_facets", edge_facets, MAX_EDGE_FACETS)
     if not tr <= 0.5 * ln:
         raise ValueError(f"return_thickness ({tr} m) must be at most half the façade length ({0.5 * ln} m)")
     if isinstance(slope_deg, bool) or not isinstance(slope_deg, (int, float)) or not abs(slope_deg) < 45:
         raise ValueError(f"slope_deg must be an angle in (-45, 45) degrees, got {slope_deg!r}")
-    if not math.isfinite(rocking_velocity):
-        raise ValueError(f"rocking_velocity must be finite [rad/s], got {rocking_velocity!r}")
+    real_number(rocking_velocity, "rocking_velocity [rad/s]")
+    material = _material("material", material)
+    return_material = _material("return_material", return_material)
     phi = math.radians(slope_deg)
     # inner top edge after the lean (rotation about y by -phi moves the top towards -x)
     rot = axis_angle_matrix(np.array([0.0, 1.0, 0.0]), -phi)
@@ -567,6 +609,8 @@ def two_block_wall(
             f"rod_height ({zr} m) must place the rods ({s} m) on the top block, between the crack "
             f"({hc} m) and the top ({h} m)"
         )
+    material = _material("material", material)
+    rod_material = _material("rod_material", rod_material)
     d0 = _non_negative("push_displacement", push_displacement)
     if not d0 < t:
         raise ValueError(f"push_displacement ({d0} m) must be below the thickness ({t} m) or the wall overturns")
@@ -597,10 +641,6 @@ def two_block_wall(
 
 
 # -- TOML forms -------------------------------------------------------------------------------------
-def _points(t: Table, across: int = 2, along: int = 2) -> tuple[int, int]:
-    return (t.integer("points_across", across, min_=1), t.integer("points_along", along, min_=1))
-
-
 def _sub_material(t: Table, key: str, *, spacing: float) -> JointMaterial | None:
     """Material from the optional sub-table ``key`` (None when absent)."""
     if key not in t.data:
@@ -616,14 +656,12 @@ def _sub_material(t: Table, key: str, *, spacing: float) -> JointMaterial | None
 def _stack_case(t: Table, b: ModelBuilder) -> Monitors:
     """Stacked blocks. Keys: width, length, heights (list) [m], density, points_across,
     points_along and the joint keys (youngs_modulus: kn = E / mean block height)."""
-    raw = t.raw("heights")
-    if not isinstance(raw, list) or not raw or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw):
-        raise ValueError(f"[{t.where}] heights must be a non-empty list of block heights [m], got {raw!r}")
-    heights = [float(v) for v in raw]
+    heights = [float(v) for v in t.numbers("heights", positive=True)]
+    _block_count(f"[{t.where}] heights ({len(heights)} entries)", len(heights))
     width = t.number("width", positive=True)
     length = t.number("length", 1.0, positive=True)
     density = t.number("density", 1800.0, positive=True)
-    pts = _points(t)
+    pts = t.points()
     mat = joint_material(t, spacing=sum(heights) / len(heights))
     return stacked_blocks(b, width=width, length=length, heights=heights, density=density, material=mat, points=pts)
 
@@ -640,7 +678,7 @@ def _wall_case(t: Table, b: ModelBuilder) -> Monitors:
         bricks_per_course=t.integer("bricks_per_course", min_=1),
         bond=t.string("bond", "running", choices=BONDS),
         density=t.number("density", 1800.0, positive=True),
-        points=_points(t, 2, 3),
+        points=t.points(2, 3),
         base_reduction=t.number("base_reduction", 0.0, min_=0.0),
     )
     if "joint" not in t.data:
@@ -662,7 +700,7 @@ def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
     brick = tuple(float(v) for v in t.vector("brick", size=2)) if "brick" in t.data else None
     t.used.add("brick")
     bond = t.string("bond", "running", choices=BONDS)
-    pts = _points(t, 2, 3 if brick is not None else 2)
+    pts = t.points(2, 3 if brick is not None else 2)
     spacing = height if brick is None else height / max(1, round(height / brick[1]))
     mat = joint_material(t, spacing=spacing)
     return parapet(
@@ -700,11 +738,11 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
         return_height=rh,
         gap=t.number("gap", 0.004, min_=0.0),
         edge_radius=t.number("edge_radius", 0.0, min_=0.0),
-        edge_facets=t.integer("edge_facets", 4, min_=1),
+        edge_facets=t.integer("edge_facets", 4, min_=1, max_=MAX_EDGE_FACETS),
         slope_deg=t.number("slope_deg", 0.0),
         material=mat,
         return_material=_sub_material(t, "return", spacing=height),
-        points=_points(t),
+        points=t.points(),
         rocking_velocity=t.number("rocking_velocity", 0.0),
     )
 
@@ -735,5 +773,5 @@ def _two_block_case(t: Table, b: ModelBuilder) -> Monitors:
         push_time=t.number("push_time", 1.0, positive=True),
         hold_time=t.number("hold_time", 0.1, min_=0.0),
         withdraw_speed=t.number("withdraw_speed", 1.0, positive=True),
-        points=_points(t),
+        points=t.points(),
     )

@@ -1,4 +1,7 @@
-"""Studies at scale: sweeps of small picklable run specs, a crash-safe store, executors (DESIGN §5).
+"""Studies at scale: sweeps of small picklable run specs, a crash-safe store, executors.
+
+The paper points to damping values fitted by "lengthy and tedious trial and error" (Galvez et al. 2022,
+§4.2); here the runs of such a search, a sensitivity study or an IDA are specs run at scale.
 
 A study is a base case (a case dict, e.g. ``example_case("free-rocking")``) plus variations
 (grid, list or seeded random samples of ``"table.key"`` overrides). Each variation becomes a
@@ -8,6 +11,8 @@ decimated history. :func:`execute` runs the specs that are not yet in a :class:`
 local process pool (default, all cores) or on a Dask cluster, appending each finished row to the
 store at once (flushed and fsynced): an interrupted study loses no finished run and a rerun skips
 finished specs. :func:`study_table` builds the pandas table (CSV, and Parquet when available).
+Pool workers exit when the process that started them dies (a killed sweep leaves no orphan), and an
+interrupted sweep (Ctrl-C, SIGTERM, SIGHUP) stops its workers at once; its finished rows are kept.
 
 Command line: ``rockdem sweep STUDY.toml``, ``rockdem calibrate``, ``rockdem fragility`` (the
 latter two from :mod:`rockdem.calibration` and :mod:`rockdem.fragility`, registered here).
@@ -23,8 +28,8 @@ import itertools
 import json
 import math
 import os
+import sys
 import time
-import tomllib
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -34,7 +39,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .case import apply_overrides, example_case, example_names, load_case, parse_case
+from .cli import integer_at_least, positive_float, positive_int, stop_on_signals
+from .case import MAX_MAGNITUDE, apply_overrides, check_plausible, example_case, example_names, load_case, parse_case, read_toml
 
 __all__ = [
     "RunSpec",
@@ -59,6 +65,8 @@ TIMING_COLUMNS = ("runtime_s", "wall_s")
 """Row entries that measure time and therefore differ between otherwise identical runs."""
 
 EXECUTORS = ("process", "serial", "dask")
+MAX_RUNS = 100_000
+"""Most runs of one study (grid, list and random variations multiplied)."""
 FINISHED = ("ok", "diverged")
 """Row statuses of finished runs (a diverged run is deterministic: rerunning it gives the same row)."""
 
@@ -106,10 +114,16 @@ class RunSpec:
     @classmethod
     def make(cls, base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None, **kwargs: Any) -> "RunSpec":
         """Build a spec from an overrides mapping ``{"damping.beta": 0.002, ...}``."""
+        if not isinstance(base, Mapping):
+            raise ValueError(f"base must be a case dict (e.g. example_case('free-rocking')), got {base!r}"[:200])
+        if overrides is not None and not isinstance(overrides, Mapping):
+            raise ValueError(f"overrides must be a mapping of 'table.key' to values, got {overrides!r}"[:200])
         items = tuple(sorted((str(k), _plain(v)) for k, v in (overrides or {}).items()))
         for key in ("duration", "pga_g", "history_interval"):
             if kwargs.get(key) is not None:
-                kwargs[key] = float(kwargs[key])
+                kwargs[key] = _positive(kwargs[key], key)
+        if kwargs.get("pga_g") is not None:
+            check_plausible(kwargs["pga_g"], "pga_g", "pga_g")
         return cls(base=base, overrides=items, **kwargs)
 
     def to_json(self) -> dict[str, Any]:
@@ -171,6 +185,24 @@ def _file_sha1(record: str) -> str:
         return hashlib.sha1(resolve_record(record).read_bytes()).hexdigest()
     except (FileNotFoundError, ValueError):
         return "missing"
+
+
+def _positive(value: Any, what: str) -> float:
+    """A positive finite number, or ValueError naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.number)) or not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{what} must be a positive number, got {value!r}")
+    if value > MAX_MAGNITUDE:
+        raise ValueError(f"{what} = {value!r} is beyond any plausible value; check the units")
+    return float(value)
+
+
+def _workers(value: Any, what: str = "workers") -> int | None:
+    """None (all cores) or an integer >= 1."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise ValueError(f"{what} must be an integer >= 1 (processes; omit it for all cores), got {value!r}")
+    return int(value)
 
 
 def _toml_value(v: Any) -> str:
@@ -329,18 +361,50 @@ def _json_default(v: Any) -> Any:
 # --------------------------------------------------------------------------------------------------
 # executors
 # --------------------------------------------------------------------------------------------------
+def exit_with_parent() -> None:
+    """Pool-worker initializer: a daemon thread ends this process as soon as the process that
+    started it dies (its sentinel pipe closes), so that killing a sweep, even with SIGKILL, leaves
+    no orphaned worker running."""
+    import multiprocessing as mp
+    import threading
+
+    parent = mp.parent_process()
+    if parent is None:
+        return
+
+    def watch() -> None:
+        parent.join()  # returns when the parent process is gone
+        os._exit(1)
+
+    threading.Thread(target=watch, name="rockdem-exit-with-parent", daemon=True).start()
+
+
+def _stop_workers(pool: Any) -> None:
+    """Terminate a process pool's workers now (an interrupted study does not wait for them)."""
+    terminate = getattr(pool, "terminate_workers", None)  # Python >= 3.14
+    if callable(terminate):
+        terminate()
+        return
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        proc.terminate()
+
+
 def _iter_process(specs: Sequence[RunSpec], workers: int | None, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     n = workers or os.cpu_count() or 1
-    pool = ProcessPoolExecutor(max_workers=min(n, len(specs)), mp_context=mp.get_context("spawn"))
+    pool = ProcessPoolExecutor(max_workers=min(n, len(specs)), mp_context=mp.get_context("spawn"), initializer=exit_with_parent)
+    finished = False
     try:
         futures = [pool.submit(fn, s) for s in specs]
         for fut in as_completed(futures):
             yield fut.result()
+        finished = True
     finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+        if not finished:  # interrupted (Ctrl-C, SIGTERM) or failed: stop the running workers now
+            _stop_workers(pool)
+        pool.shutdown(wait=finished, cancel_futures=True)
 
 
 def _iter_dask(specs: Sequence[RunSpec], scheduler: Any, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
@@ -391,6 +455,7 @@ def execute(
         raise ValueError(f"executor must be one of {EXECUTORS}, got {executor!r}")
     if executor == "dask" and scheduler is None:
         raise ValueError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
+    workers = _workers(workers)
     unique: dict[str, RunSpec] = {}
     for s in specs:
         unique.setdefault(s.id, s)
@@ -411,11 +476,16 @@ def execute(
             it = _iter_process(todo, workers, _safe_run)
         else:
             it = _iter_dask(todo, scheduler, _safe_run)
-        for row in it:
-            if st is not None:
-                st.append(row)
-            results[row["id"]] = row
-            bar.update(1)
+        try:
+            for row in it:
+                if st is not None:
+                    st.append(row)
+                results[row["id"]] = row
+                bar.update(1)
+        finally:
+            close = getattr(it, "close", None)
+            if close is not None:
+                close()  # an interrupted study stops its workers here, not at garbage collection
     finally:
         bar.close()
     return [results[i] for i in unique if i in results]
@@ -471,19 +541,30 @@ def histories(rows: Store | Iterable[Mapping[str, Any]]) -> dict[str, dict[str, 
 # --------------------------------------------------------------------------------------------------
 def expand_grid(params: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
     """Full factorial: ``{"a": [1, 2], "b": [3]}`` -> ``[{"a": 1, "b": 3}, {"a": 2, "b": 3}]``."""
+    if not isinstance(params, Mapping):
+        raise ValueError(f"grid must be a table of \"table.key\" = [values], got {params!r}"[:200])
     keys = list(params)
     for k in keys:
         if not isinstance(params[k], (list, tuple)) or len(params[k]) == 0:
-            raise ValueError(f"grid parameter {k!r}: give a non-empty list of values")
+            raise ValueError(f"grid parameter {k!r}: give a non-empty list of values, got {params[k]!r}"[:200])
+    _run_count(math.prod(len(params[k]) for k in keys), "grid")
     return [dict(zip(keys, combo)) for combo in itertools.product(*(params[k] for k in keys))]
+
+
+def _run_count(n: int, what: str) -> None:
+    if n > MAX_RUNS:
+        raise ValueError(f"{what}: {n} runs exceed the limit of {MAX_RUNS} per study; split the study")
 
 
 def expand_list(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """Explicit variations, one mapping per run."""
+    if isinstance(rows, (str, bytes, Mapping)) or not isinstance(rows, Sequence):
+        raise ValueError(f"list: give a list of tables of \"table.key\" = value, got {rows!r}"[:200])
+    _run_count(len(rows), "list")
     out = []
     for r in rows:
         if not isinstance(r, Mapping):
-            raise ValueError(f"list variation {r!r}: give a table of table.key = value")
+            raise ValueError(f"list variation {r!r}: give a table of table.key = value"[:200])
         out.append(dict(r))
     return out
 
@@ -491,20 +572,34 @@ def expand_list(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
 def expand_random(ranges: Mapping[str, Any], n: int, seed: int) -> list[dict[str, Any]]:
     """``n`` seeded uniform samples; a range is ``[low, high]`` or ``{low, high, log = true}``
     (log-uniform) or a list of more than two choices (``{choices = [...]}``)."""
-    if n < 1:
-        raise ValueError(f"random: n must be >= 1, got {n}")
+    if not isinstance(ranges, Mapping):
+        raise ValueError(f"random must be a table of \"table.key\" = [low, high] (and n, seed), got {ranges!r}"[:200])
+    for what, v, low in (("n", n, 1), ("seed", seed, 0)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
+            raise ValueError(f"random: {what} must be an integer >= {low}, got {v!r}")
+    _run_count(int(n), "random: n")
     rng = np.random.default_rng(seed)
     out: list[dict[str, Any]] = [{} for _ in range(n)]
     for key in sorted(ranges):
         r = ranges[key]
         if isinstance(r, Mapping) and "choices" in r:
-            idx = rng.integers(0, len(r["choices"]), size=n)
-            vals = [r["choices"][i] for i in idx]
+            choices = r["choices"]
+            if not isinstance(choices, (list, tuple)) or not choices:
+                raise ValueError(f"random parameter {key!r}: choices must be a non-empty list, got {choices!r}")
+            idx = rng.integers(0, len(choices), size=n)
+            vals = [choices[i] for i in idx]
         else:
-            lo, hi, log = (r["low"], r["high"], bool(r.get("log", False))) if isinstance(r, Mapping) else (*r, False)
-            lo, hi = float(lo), float(hi)
-            if not hi > lo or (log and lo <= 0):
-                raise ValueError(f"random parameter {key!r}: need low < high (and low > 0 for log)")
+            try:
+                lo, hi, log = (r["low"], r["high"], r.get("log", False)) if isinstance(r, Mapping) else (*r, False)
+                if isinstance(r, (str, bytes)) or isinstance(lo, bool) or isinstance(hi, bool):
+                    raise TypeError
+                lo, hi = float(lo), float(hi)
+            except (TypeError, ValueError, KeyError):
+                raise ValueError(
+                    f"random parameter {key!r}: give [low, high], {{low, high, log = true}} or {{choices = [...]}}, got {r!r}"[:200]
+                ) from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo) or (log and lo <= 0) or not isinstance(log, bool):
+                raise ValueError(f"random parameter {key!r}: need finite low < high (and low > 0 for log = true), got {r!r}")
             u = rng.random(n)
             vals = list(np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo))) if log else lo + u * (hi - lo))
         for row, v in zip(out, vals):
@@ -532,6 +627,8 @@ def resolve_base(base: str | Mapping[str, Any], relative_to: str | os.PathLike[s
     """A base case dict from a built-in example name, a TOML path or a dict."""
     if isinstance(base, Mapping):
         return dict(base)
+    if not isinstance(base, (str, os.PathLike)):
+        raise ValueError(f"base must be a built-in example name, a case file path or a case dict, got {base!r}")
     if base in example_names():
         return example_case(base)
     p = Path(base)
@@ -554,8 +651,8 @@ class Study:
 
 def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] | None = None, name: str = "study") -> Study:
     """Build a :class:`Study` from a dict of the study file format (see docs/studies.md)."""
-    if "study" not in data:
-        raise ValueError("a study file needs a [study] table")
+    if not isinstance(data, Mapping) or not isinstance(data.get("study"), Mapping):
+        raise ValueError("a study file needs a [study] table (base, duration, grid/list/random)")
     s = dict(data["study"])
     allowed = {"base", "duration", "executor", "workers", "scheduler", "set", "grid", "list", "random", "history", "history_interval", "name"}
     unknown = sorted(set(s) - allowed)
@@ -563,40 +660,55 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
         raise ValueError(f"[study] unknown key(s) {unknown}; accepted keys are {sorted(allowed)}")
     if "base" not in s:
         raise ValueError('[study] needs base = "free-rocking" (a built-in example) or a case file path')
+    if not isinstance(s["base"], (str, Mapping)):
+        raise ValueError(f'[study] base must be a built-in example name or a case file path (a string), got {s["base"]!r}')
+    for key, kind in (("name", str), ("scheduler", str), ("history", bool)):
+        if key in s and not isinstance(s[key], kind):
+            raise ValueError(f"[study] {key} must be a {'string' if kind is str else 'true or false'}, got {s[key]!r}")
+    for key in ("duration", "history_interval"):
+        if key in s:
+            _positive(s[key], f"[study] {key} [s]")
+    workers = _workers(s.get("workers"), "[study] workers")
     base = resolve_base(s["base"], relative_to)
-    fixed = dict(s.get("set", {}))
+    fixed = s.get("set", {})
+    if not isinstance(fixed, Mapping):
+        raise ValueError(f'[study] set must be a table of "table.key" = value, got {fixed!r}')
     parts: list[list[dict[str, Any]]] = []
-    if "grid" in s:
-        parts.append(expand_grid(s["grid"]))
-    if "list" in s:
-        lst = s["list"]
-        parts.append(expand_list(lst["rows"] if isinstance(lst, Mapping) else lst))
-    if "random" in s:
-        r = dict(s["random"])
-        n, seed = int(r.pop("n", 10)), int(r.pop("seed", 0))
-        parts.append(expand_random(r, n, seed))
+    try:
+        if "grid" in s:
+            parts.append(expand_grid(s["grid"]))
+        if "list" in s:
+            lst = s["list"]
+            parts.append(expand_list(lst["rows"] if isinstance(lst, Mapping) and "rows" in lst else lst))
+        if "random" in s:
+            r = s["random"]
+            if not isinstance(r, Mapping):
+                raise ValueError(f"random must be a table of \"table.key\" = [low, high] (and n, seed), got {r!r}")
+            r = dict(r)
+            n, seed = r.pop("n", 10), r.pop("seed", 0)
+            parts.append(expand_random(r, n, seed))
+    except ValueError as exc:
+        raise ValueError(f"[study] {exc}") from None
+    _run_count(math.prod(len(p) for p in parts), "[study] grid x list x random")
     variations = [{}]
     for part in parts:
         variations = [{**a, **b} for a in variations for b in part]
-    executor = str(s.get("executor", "process"))
+    executor = s.get("executor", "process")
     if executor not in EXECUTORS:
         raise ValueError(f"[study] executor must be one of {EXECUTORS}, got {executor!r}")
+    if executor == "dask" and not s.get("scheduler"):
+        raise ValueError('[study] executor = "dask" needs scheduler = "tcp://HOST:PORT" (or --scheduler)')
     specs = make_specs(
-        base, variations, fixed=fixed, duration=s.get("duration"), history=bool(s.get("history", False)),
+        base, variations, fixed=fixed, duration=s.get("duration"), history=s.get("history", False),
         history_interval=s.get("history_interval"),
     )
-    return Study(str(s.get("name", name)), specs, executor, s.get("workers"), s.get("scheduler"), s)
+    return Study(str(s.get("name", name)), specs, executor, workers, s.get("scheduler"), s)
 
 
 def load_study(path: str | os.PathLike[str]) -> Study:
     """Read a study TOML file."""
+    data = read_toml(path, "study file")
     p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"study file {p} does not exist")
-    try:
-        data = tomllib.loads(p.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{p}: not valid TOML: {exc}") from None
     return parse_study(data, relative_to=p.parent, name=p.stem)
 
 
@@ -616,17 +728,35 @@ def run_study(study: Study, out: str | os.PathLike[str], *, executor: str | None
 # --------------------------------------------------------------------------------------------------
 def _add_exec_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--executor", choices=EXECUTORS, default=None, help="default: the study's, else process")
-    p.add_argument("--workers", type=int, default=None, help="processes of the local pool (default: all cores)")
+    p.add_argument("--workers", type=positive_int, default=None, help="processes of the local pool (default: all cores)")
     p.add_argument("--scheduler", default=None, help="Dask scheduler address, e.g. tcp://10.0.0.5:8786")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def check_first_run(specs: Sequence[RunSpec], what: str = "the study") -> None:
+    """Build the first run's case (no simulation) so that a bad base case or override is refused
+    before any run starts, instead of ending as one error row per run."""
+    if specs:
+        try:
+            parse_case(specs[0].case_dict())
+        except (ValueError, FileNotFoundError) as exc:
+            raise ValueError(f"{what}'s first run is not a valid case: {exc}") from None
 
 
 def _sweep(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     out = Path(args.out) if args.out else Path(args.study).with_suffix("")
+    check_first_run(study.specs)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is an existing file; give a folder for runs.jsonl and table.csv")
     t0 = time.perf_counter()
-    df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
-                   progress=not args.no_progress)
+    try:
+        with stop_on_signals():  # SIGTERM and SIGHUP stop the sweep and its workers as Ctrl-C does
+            df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
+                           progress=not args.no_progress)
+    except KeyboardInterrupt:
+        print(f"rockdem sweep: stopped; the finished runs are kept in {Store(out).path} (rerun to resume)", file=sys.stderr)
+        raise
     n_err = int((df["status"] == "error").sum()) if "status" in df else 0
     n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0
     print(f"{len(df)} runs ({n_err} failed, {n_div} diverged) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
@@ -636,7 +766,10 @@ def _sweep(args: argparse.Namespace) -> int:
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add ``sweep``, ``calibrate`` and ``fragility``."""
     p = subparsers.add_parser("sweep", help="run (or resume) a parameter study from a study TOML file",
-                              description="Run a study file; finished runs are kept in OUT/runs.jsonl and skipped on rerun.")
+                              description="Run a study file; finished runs are kept in OUT/runs.jsonl and skipped on rerun.",
+                              epilog="Exit status: 0 done; 1 some runs failed (see table.csv); 2 bad input (nothing run); "
+                              "128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP): the pool workers are "
+                              "stopped, the finished runs kept; rerun to resume. Workers also exit if the sweep is killed.")
     p.add_argument("study", help="study TOML file ([study] base, duration, grid/list/random)")
     p.add_argument("--out", "-o", default=None, help="output folder (default: the study file name)")
     _add_exec_args(p)
@@ -649,3 +782,22 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
                 raise
             continue
         module.register_cli(subparsers, _add_exec_args)
+    for name in ("calibrate", "fragility"):
+        if name in subparsers.choices:
+            _check_flags(subparsers.choices[name])
+
+
+_FLAG_TYPES: dict[str, Callable[[str], Any]] = {
+    "workers": positive_int,
+    "duration": positive_float,
+    "scan": integer_at_least(3),  # the coarse scan of calibrate needs 3 points to bracket a minimum
+    "drift_limit": positive_float,
+}
+"""Checks of the numeric flags shared by the study commands (calibrate, fragility)."""
+
+
+def _check_flags(parser: argparse.ArgumentParser) -> None:
+    """Give the numeric flags of a study command their checked types (bad values exit 2 naming the flag)."""
+    for action in parser._actions:
+        if action.dest in _FLAG_TYPES:
+            action.type = _FLAG_TYPES[action.dest]

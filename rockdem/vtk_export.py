@@ -30,6 +30,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 import xarray as xr
 
+from .cli import positive_int
 from .kernels.rotation import quats_to_matrices
 from .plots import Result, load_result
 
@@ -223,10 +224,30 @@ def export_vtk(result: Result, directory: str | Path, *, every: int = 1, contact
     return pvd
 
 
+def read_result_file(path: str | Path) -> xr.Dataset:
+    """A rockdem result read from ``path`` for a command: FileNotFoundError or ValueError naming the
+    file when it is missing, not a regular file or not a result."""
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"result file {p} does not exist (rockdem run writes OUT/result.nc)")
+    if not p.is_file():
+        raise ValueError(f"result file {p} is not a regular file; give the result.nc written by rockdem run")
+    try:
+        ds = load_result(p)
+    except (ValueError, OSError, KeyError) as exc:
+        raise ValueError(f"{p} is not a rockdem result (the NetCDF file written by rockdem run): {str(exc)[:200]}") from None
+    if "block_free" not in ds or "time" not in ds.coords:
+        raise ValueError(f"{p} is not a rockdem result: it has no block_free or time")
+    return ds
+
+
 def _export(args: argparse.Namespace) -> int:
     if not args.vtk:
         raise ValueError("export: give --vtk DIR, the folder for the .vtu files and the .pvd series")
-    p = export_vtk(args.result, args.vtk, every=args.every, contacts=not args.no_contacts)
+    out = Path(args.vtk)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--vtk {out} is an existing file; give a folder")
+    p = export_vtk(read_result_file(args.result), out, every=args.every, contacts=not args.no_contacts)
     print(f"rockdem export: wrote {p} (open it in ParaView)")
     return 0
 
@@ -234,8 +255,8 @@ def _export(args: argparse.Namespace) -> int:
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``export`` sub-command."""
     p = subparsers.add_parser("export", help="export a result for ParaView (VTK files and a .pvd series)")
-    p.add_argument("result", metavar="RESULT.nc")
+    p.add_argument("result", metavar="RESULT.nc", help="a result written by rockdem run")
     p.add_argument("--vtk", metavar="DIR", help="folder for blocks_*.vtu, contacts_*.vtu and the .pvd files")
-    p.add_argument("--every", type=int, default=1, help="export every n-th recorded frame (default 1)")
+    p.add_argument("--every", type=positive_int, default=1, help="export every n-th recorded frame (default 1)")
     p.add_argument("--no-contacts", action="store_true", help="skip the contact snapshots")
     p.set_defaults(func=_export)

@@ -1,6 +1,6 @@
 """Verification of the damping advisor against the paper's own numbers and its equations.
 
-References: Galvez et al. 2022 (Eq. 1-5, §2.2, §3.1, §3.2.1 Table 1, §4.2) and DESIGN §2-3.
+References: Galvez et al. 2022 (Eq. 1-5, §2.2, §3.1, §3.2.1 Table 1, §4.2, §4.4).
 Tolerances: the paper quotes 2-3 significant figures, so a value is accepted within one unit of
 its last quoted digit; identities between our own outputs are checked to round-off (rel 1e-12).
 """
@@ -21,7 +21,7 @@ FACADE = dict(width=0.11, height=0.8, length=1.5, density=1750.0, youngs_modulus
 
 def test_beta_two_sided_and_one_sided_match_paper_section_4_2() -> None:
     # §4.2: beta = 0.00470 (two-sided) and 0.00017 (one-sided), beta = 2 zeta / omega_crit with
-    # zeta = 1 (DESIGN §3). Quoted to 2 significant figures: accept one unit of the last digit.
+    # zeta = 1 (§2.2). Quoted to 2 significant figures: accept one unit of the last digit.
     two = advise(**FACADE)
     one = advise(**FACADE, configuration="one-sided")
     assert abs(two.beta_sp - 0.0047) < 1e-4
@@ -83,8 +83,9 @@ def test_damping_parameters_follow_eq_4_and_5() -> None:
 
 
 def test_joint_stiffness_section_3() -> None:
-    # §3: kn = E / l with l = H / n_b; ks = kn / (2 (1 + nu)) = 0.4 kn for nu = 0.25.
-    adv = advise(**FACADE, blocks=10)
+    # §3: kn = E / l with l = H / n_b; ks = kn / (2 (1 + nu)) = 0.4 kn for nu = 0.25. A discretised
+    # block rocking as a whole (§3.2.2): configuration single, given explicitly with blocks > 1.
+    adv = advise(**FACADE, blocks=10, configuration="single")
     assert adv.kn == pytest.approx(1.8e9 / 0.08, rel=1e-12)
     assert adv.ks == pytest.approx(0.4 * adv.kn, rel=1e-12)
 
@@ -171,3 +172,36 @@ def test_cli_table_json_and_errors(capsys: pytest.CaptureFixture[str]) -> None:
     assert data["outputs"]["beta_sp"]["unit"] == "s"
     assert main(base + ["--youngs-modulus", "-5"]) == 2
     assert "youngs_modulus" in capsys.readouterr().err
+
+
+def test_several_blocks_imply_stacked_and_length_only_changes_the_timestep(capsys: pytest.CaptureFixture[str]) -> None:
+    # A two-block wall (paper §4.4, B = 0.11 m, H = 1.5 m): each block rocks (stacked, §2.2:
+    # omega_crit = sqrt 2 omega_e of an H/2 block). --blocks 2 without --configuration used to give
+    # the single-block beta, sqrt(2) x 2 = 2.8 times too large.
+    wall = dict(width=0.11, height=1.5, density=1800.0, youngs_modulus=4.8e7)
+    implied = advise(**wall, blocks=2)
+    stacked = advise(**wall, blocks=2, configuration="stacked")
+    single = advise(**wall, blocks=2, configuration="single")  # explicit: a discretised element rocking as a whole
+    assert implied.inputs.configuration is Configuration.STACKED and implied.inputs.configuration_implied
+    assert implied.beta_sp == stacked.beta_sp
+    assert single.beta_sp / stacked.beta_sp == pytest.approx(2.0 * math.sqrt(2.0), rel=1e-12)
+    assert advise(**wall).inputs.configuration is Configuration.SINGLE  # one block: single
+    # beta, alpha and eta do not depend on the length; only the timestep estimate does
+    short, long_ = advise(**wall, blocks=2, length=0.5), advise(**wall, blocks=2, length=3.0)
+    assert (short.beta_sp, short.alpha_mp, short.eta) == (long_.beta_sp, long_.alpha_mp, long_.eta)
+    assert implied.inputs.length == 1.0
+    # the command line: --length optional, the implied configuration said in the header
+    assert main(["advise", "--width", "0.11", "--height", "1.5", "--density", "1800", "--youngs-modulus-mpa", "48",
+                 "--blocks", "2", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["inputs"]["configuration"] == "stacked" and data["inputs"]["length"] == 1.0
+    assert data["outputs"]["beta_sp"]["value"] == pytest.approx(stacked.beta_sp, rel=1e-12)
+    assert main(["advise", "--width", "0.11", "--height", "1.5", "--density", "1800", "--youngs-modulus-mpa", "48",
+                 "--blocks", "2"]) == 0
+    assert "stacked (implied by 2 blocks" in capsys.readouterr().out
+
+
+def test_advisor_texts_cite_the_paper_not_internal_documents() -> None:
+    adv = advise(**FACADE)
+    texts = [src for *_, src in adv.rows()] + list(adv.recommendations) + [adv.table()]
+    assert not any("DESIGN" in t or "issue" in t.lower() for t in texts)

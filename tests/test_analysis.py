@@ -215,3 +215,28 @@ def test_bouncing_ignores_phases_that_graze_the_threshold() -> None:
     z = np.clip(v * (t - 0.01) - 0.5 * g * (t - 0.01) ** 2, 0.0, None) * (t > 0.01)
     bo = bouncing(t, z, z_rest=0.0, tol=1e-5)
     assert bo.max_magnitude == pytest.approx(v**2 / (2 * g) / (2 * v / g), rel=0.1)
+
+
+def test_reduced_parapet_base_gives_one_eta_for_tilt_summary_and_plot():
+    # A 0.3 x 1.8 m parapet with a 20 mm base reduction rocks on its 0.28 m base contact face:
+    # eta = atan(0.14 / z_c) ~ 0.1543 rad, not atan(0.3 / 1.8) = 0.1651 rad of the full width.
+    # The release (tilt), the result's block_eta, summarize_result and plot_restitution must all
+    # use the same pivot (round-off: the tilt angle is 0.9 eta).
+    from rockdem.case import parse_case
+    from rockdem.plots import plot_restitution
+    from rockdem.run_cli import run_case
+
+    case = {
+        "run": {"duration": 0.3, "record_interval": 0.01},
+        "damping": {"beta": 0.0007},
+        "specimen": {"type": "parapet", "thickness": 0.3, "height": 1.8, "length": 1.0, "base_reduction": 0.02,
+                     "youngs_modulus": 1.8e9, "friction_angle_deg": 31.0, "cohesion": 0.0, "tension": 0.0},
+        "loading": {"type": "free-rocking", "block": "parapet", "tilt_fraction": 0.9},
+    }
+    ds = run_case(parse_case(case), progress=False)
+    eta = float(ds.attrs["tilt_angle_rad"]) / 0.9
+    assert eta == pytest.approx(math.atan(0.14 / 0.9), rel=2e-3)  # centroid a little above H/2 (chamfers)
+    b = int(np.flatnonzero(ds.block_free.values)[0])
+    assert float(ds.block_eta.values[b]) == pytest.approx(eta, rel=1e-12)
+    assert summarize_result(ds)["eta_rad"] == pytest.approx(eta, rel=1e-12)
+    assert f"η = {eta:.4f} rad" in plot_restitution(ds).axes[0].get_title()

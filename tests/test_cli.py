@@ -11,7 +11,7 @@ def test_run_builtin_example_writes_results_plot_and_summary(tmp_path, capsys):
     out = tmp_path / "fr"
     assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "1.5", "--quiet"]) == 0
     text = capsys.readouterr().out
-    for key in ("steps", "dt", "runtime", "peak rotation", "energy balance"):
+    for key in ("steps", "timestep", "run time", "peak rotation", "energy balance"):
         assert key in text
     ds = load(out / "result.nc")
     # Released from 0.9 eta of the 0.2 x 2 m block, the angle after 1.5 s has crossed zero once
@@ -56,3 +56,131 @@ def test_package_root_exports_the_api():
     assert rockdem.ModelBuilder is __import__("rockdem.model", fromlist=["ModelBuilder"]).ModelBuilder
     with pytest.raises(AttributeError, match="no attribute 'nope'"):
         rockdem.nope  # noqa: B018
+
+
+def test_version(capsys):
+    import rockdem
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"rockdem {rockdem.__version__}"
+
+
+def test_summary_is_an_aligned_table_with_units(tmp_path, capsys):
+    assert main(["run", "--example", "free-rocking", "--out", str(tmp_path), "--duration", "0.3", "--quiet", "--no-plot"]) == 0
+    rows = capsys.readouterr().out.splitlines()[1:]
+    table = [r for r in rows if not r.strip().startswith(("wrote", "DIVERGED", "INTERRUPTED"))]
+    # label (26 columns), value right-aligned in the next 12, unit in the next 5
+    ends = {len(r[: 2 + 26 + 1 + 12].rstrip()) for r in table}
+    assert ends == {2 + 26 + 1 + 12}, table
+    by_label = {r[2:28].strip(): r[29:].split() for r in table}
+    assert by_label["peak rotation"][1] == "rad" and "'block'," in by_label["peak rotation"]
+    assert by_label["peak |u| at top"][1] == "mm"
+    assert by_label["timestep"][1] == "s"
+    assert "block block" not in "\n".join(rows)
+
+
+def test_summary_survives_a_run_stopped_at_zero_or_one_frame():
+    from conftest import rocking_block
+    from rockdem.run_cli import summary_lines
+    from rockdem.simulate import simulate
+
+    ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.02, record_interval=0.01)
+    for n in (0, 1):  # a run that diverges at t = 0 keeps 0 or 1 frames: IndexError before
+        cut = ds.isel(time=slice(0, n))
+        cut.attrs.update(diverged=1, diverged_time=0.0)
+        lines = summary_lines(cut)
+        assert any(line.startswith("DIVERGED at t = 0 s") for line in lines)
+        assert any(line.startswith("time simulated") for line in lines)
+
+
+def test_bad_output_folder_is_refused_before_the_run(tmp_path, capsys, monkeypatch):
+    import rockdem.run_cli
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(rockdem.run_cli, "run_case", no_run)
+    afile = tmp_path / "notes.txt"
+    afile.write_text("x")
+    assert main(["run", "--example", "free-rocking", "--out", str(afile), "--quiet"]) == 2
+    assert f"--out {afile} is an existing file; give a folder" in capsys.readouterr().err
+    assert main(["run", "--example", "free-rocking", "--out", str(afile / "sub"), "--quiet"]) == 2
+    assert "cannot write there" in capsys.readouterr().err
+    (tmp_path / "o" / "result.nc").mkdir(parents=True)
+    assert main(["run", "--example", "free-rocking", "--out", str(tmp_path / "o"), "--quiet"]) == 2
+    assert "result.nc is a folder" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["SIGTERM", "SIGHUP", "SIGINT"])
+def test_stop_signals_save_the_frames_computed_so_far(tmp_path, capsys, monkeypatch, name):
+    """SIGTERM and SIGHUP (as Ctrl-C) stop a run inside the time loop; the partial result is saved
+    and the exit status is 128 + the signal number (nothing was written for SIGTERM/SIGHUP before)."""
+    import os
+    import signal
+
+    import rockdem.simulate
+
+    sig = getattr(signal, name, None)
+    if sig is None:
+        pytest.skip(f"no {name} on this platform")
+    real, calls = rockdem.simulate.advance, []
+
+    def advance(*args):
+        frame = real(*args)
+        calls.append(frame)
+        if len(calls) == 2:
+            os.kill(os.getpid(), sig)  # delivered in the loop, between two compiled chunks
+        return frame
+
+    monkeypatch.setattr(rockdem.simulate, "advance", advance)
+    code = main(["run", "--example", "free-rocking", "--out", str(tmp_path), "--duration", "60", "--quiet", "--no-plot"])
+    assert code == 128 + sig
+    assert "INTERRUPTED" in capsys.readouterr().out
+    ds = load(tmp_path / "result.nc")
+    assert ds.attrs["interrupted"] == 1
+    assert 0 < float(ds.time[-1]) < 60.0 and ds.sizes["time"] in calls  # the frames of finished chunks
+    assert signal.getsignal(sig) is not None  # handlers restored after the run
+
+
+def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_path, capsys, monkeypatch):
+    import os
+    import signal
+
+    import rockdem.run_cli
+
+    real = rockdem.run_cli.save
+    for count, code, saved in ((1, 130, True), (2, 130, False)):
+        out = tmp_path / str(count)
+
+        def save(ds, path, count=count):
+            for _ in range(count):
+                os.kill(os.getpid(), signal.SIGINT)
+            return real(ds, path)
+
+        monkeypatch.setattr(rockdem.run_cli, "save", save)
+        assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.05", "--quiet", "--no-plot"]) == code
+        err = capsys.readouterr().err
+        assert "saving the results computed so far; interrupt again to abandon" in err
+        assert (out / "result.nc").exists() == saved
+        if not saved:
+            assert "stopped by SIGINT" in err
+
+
+def test_command_modules_without_a_command_are_skipped(monkeypatch):
+    import rockdem.cli
+
+    assert "rockdem.records" in rockdem.cli._COMMAND_MODULES
+    monkeypatch.setattr(rockdem.cli, "_COMMAND_MODULES", (*rockdem.cli._COMMAND_MODULES, "rockdem.geometry", "rockdem.nope"))
+    parser = rockdem.cli.build_parser()
+    assert "run" in parser._subparsers._group_actions[0].choices
+
+
+def test_citation_file_matches_the_package_and_cites_the_paper():
+    from pathlib import Path
+
+    import rockdem
+
+    text = (Path(__file__).parents[1] / "CITATION.cff").read_text()
+    assert "cff-version: 1.2.0" in text
+    assert f"\nversion: {rockdem.__version__}\n" in text
+    assert "doi: 10.1002/eqe.3598" in text and "Damping considerations for rocking block dynamics" in text

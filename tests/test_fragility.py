@@ -1,4 +1,4 @@
-"""Fragility fits (issue 5): synthetic lognormal data, and a small IDA on a synthetic record."""
+"""Fragility fits: synthetic lognormal data, and a small IDA on a synthetic record."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from rockdem.fragility import Fragility, collapse_capacities, fit_fragility_capacities, fit_fragility_mle, run_ida
+from rockdem.fragility import Fragility, collapse_capacities, fit_fragility_capacities, fit_fragility_mle, ida_counts, run_ida
 
 THETA, BETA = 0.4, 0.35  # median [g] and dispersion of the synthetic capacities
 
@@ -38,17 +38,25 @@ def test_fit_needs_failures_and_survivals():
         fit_fragility_mle([0.1, 0.2, 0.3], [0, 0, 0])
 
 
-def test_small_ida_on_synthetic_pulse(tmp_path):
-    """Sine pulses (1 Hz and 2 Hz) on the 0.19 x 0.5 m block: more PGA -> more rotation, then overturning."""
+def _pulses(tmp_path, freqs=(1.0, 2.0)) -> list[str]:
     recs = []
-    for f_hz in (1.0, 2.0):
+    for f_hz in freqs:
         t = np.arange(0, 1.0 / f_hz, 0.005)
         a = np.sin(2 * np.pi * f_hz * t)
         p = tmp_path / f"pulse{f_hz:g}.csv"
         np.savetxt(p, np.column_stack((t, a)), delimiter=",")
         recs.append(str(p))
-    fixed = {"run.record_interval": 0.01, "specimen.height": 0.5, "specimen.width": 0.19, "damping.beta": 0.0,
-             "damping.alpha": 2.0, "loading.units": "g"}
+    return recs
+
+
+FIXED = {"run.record_interval": 0.01, "specimen.height": 0.5, "specimen.width": 0.19, "damping.beta": 0.0,
+         "damping.alpha": 2.0, "loading.units": "g"}
+
+
+def test_small_ida_on_synthetic_pulse(tmp_path):
+    """Sine pulses (1 Hz and 2 Hz) on the 0.19 x 0.5 m block: more PGA -> more rotation, then overturning."""
+    recs = _pulses(tmp_path)
+    fixed = FIXED
     df, frag = run_ida("free-rocking", recs, [0.2, 0.5, 1.0, 2.0], tmp_path / "ida", fixed=fixed, duration=2.0,
                        executor="serial", progress=False)
     assert len(df) == 8 and (df["status"] == "ok").all()
@@ -58,3 +66,39 @@ def test_small_ida_on_synthetic_pulse(tmp_path):
     cap = collapse_capacities(df)
     assert cap.notna().all()
     assert (tmp_path / "ida" / "table.csv").exists() and (tmp_path / "ida" / "ida.png").exists()
+
+
+def _unreadable(tmp_path) -> str:
+    bad = tmp_path / "broken.csv"
+    bad.write_text("0.0,0.1\n0.005,0.12E-\n")  # truncated mid-number
+    return str(bad)
+
+
+def test_errored_runs_are_reported_apart_and_stay_out_of_the_fit(tmp_path):
+    # An unreadable record errors at every PGA: those runs have no outcome. They used to count as
+    # failures (NaN 'overturned' read as True) and enter the fit.
+    levels = [0.2, 0.5, 1.0, 2.0]
+    good = _pulses(tmp_path, (1.0,))
+    df, frag = run_ida("free-rocking", good + [_unreadable(tmp_path)], levels, tmp_path / "ida", fixed=FIXED,
+                       duration=2.0, executor="serial", progress=False)
+    errors = df[df["status"] == "error"]
+    assert len(errors) == 4 and errors["failed"].isna().all()
+    ok = df[df["status"] == "ok"]
+    counts = ida_counts(df)
+    assert (counts.runs, counts.errors, counts.failures + counts.survivals) == (8, 4, 4)
+    assert counts.failures == int(ok["failed"].sum()) < 4  # 0.2 g does not even rock the block
+    assert "4 errored (no outcome: not in the fit)" in counts.line()
+    # the fit is that of the completed runs alone
+    alone, frag_alone = run_ida("free-rocking", good, levels, tmp_path / "ida_ok", fixed=FIXED, duration=2.0,
+                                executor="serial", progress=False)
+    assert (frag is None) == (frag_alone is None)
+    if frag is not None:
+        assert (frag.theta, frag.beta, frag.n) == (frag_alone.theta, frag_alone.beta, frag_alone.n) and frag.n == 4
+    assert list(collapse_capacities(df).index) == good  # no capacity for a record that never ran
+
+
+def test_all_runs_errored_gives_a_clear_error(tmp_path):
+    with pytest.raises(ValueError, match=r"none of the 2 IDA runs completed.*2 errored.*first error: .*broken\.csv"):
+        run_ida("free-rocking", [_unreadable(tmp_path)], [0.2, 0.5], tmp_path / "ida", fixed=FIXED, duration=0.5,
+                executor="serial", progress=False)
+    assert (tmp_path / "ida" / "table.csv").exists()  # the table with the errors is kept for inspection

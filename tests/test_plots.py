@@ -26,7 +26,7 @@ from rockdem.plots import (
     save_figure,
     top_displacement,
 )
-from rockdem.results import save
+from rockdem.results import load, save
 from viz_cases import example_result, synthetic_result, wall_result
 
 BASELINE = Path(__file__).parent / "baseline"
@@ -35,7 +35,8 @@ BASELINE = Path(__file__).parent / "baseline"
 @pytest.fixture(scope="module")
 def result_files(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     d = tmp_path_factory.mktemp("results")
-    return {"example": save(example_result(), d / "example.nc"), "wall": save(wall_result(), d / "wall.nc")}
+    return {"example": save(example_result(), d / "example.nc"), "wall": save(wall_result(), d / "wall.nc"),
+            "pushover": save(_rod_pushover(0.3, 1.2, 0.9, 8.0), d / "pushover.nc")}
 
 
 def _nonempty_image(path: Path) -> None:
@@ -45,19 +46,91 @@ def _nonempty_image(path: Path) -> None:
     assert pixels.std() > 5.0  # something is drawn, not a blank canvas
 
 
-@pytest.mark.parametrize("which", ["example", "wall"])
+@pytest.mark.parametrize("which", ["example", "wall", "pushover"])
 @pytest.mark.parametrize("kind", sorted(PLOTS))
-def test_every_plot_command_writes_an_image(result_files, tmp_path, kind, which):
+def test_every_plot_command_writes_an_image(result_files, tmp_path, kind, which, capsys):
     out = tmp_path / f"{which}_{kind}.png"
-    assert main(["plot", str(result_files[which]), "--kind", kind, "-o", str(out), "--dpi", "50"]) == 0
+    code = main(["plot", str(result_files[which]), "--kind", kind, "-o", str(out), "--dpi", "50"])
+    if kind == "capacity" and which != "pushover":  # a capacity curve of a free-rocking run is meaningless
+        assert code == 2 and "not a pushover" in capsys.readouterr().err
+        assert not out.exists()
+        return
+    assert code == 0
     _nonempty_image(out)
 
 
-def test_plot_all_kinds_as_pdf_next_to_the_result(result_files):
+def test_plot_all_writes_the_plots_that_apply_and_says_which_it_skipped(result_files, capsys):
+    # free rocking: no capacity curve, and nothing to compare one result with
     assert main(["plot", str(result_files["example"]), "--kind", "all", "--format", "pdf"]) == 0
+    out = capsys.readouterr().out
     for kind in PLOTS:
         p = result_files["example"].with_name(f"example_{kind}.pdf")
-        assert p.read_bytes()[:5] == b"%PDF-"
+        if kind in ("capacity", "comparison"):
+            assert not p.exists() and f"skipped {kind}: " in out
+        else:
+            assert p.read_bytes()[:5] == b"%PDF-"
+    # a pushover: capacity yes, restitution and bouncing (free-rocking and impact measures) no
+    assert main(["plot", str(result_files["pushover"]), "--kind", "all"]) == 0
+    out = capsys.readouterr().out
+    assert result_files["pushover"].with_name("pushover_capacity.png").exists()
+    assert "skipped restitution: " in out and "skipped bouncing: " in out
+
+
+def _rod_pushover(b: float, h: float, z: float, duration: float):
+    """A rod pushing a b x h block at height z (displacement control) to half its instability angle."""
+    from rockdem.case import parse_case
+    from rockdem.run_cli import run_case
+
+    eta = np.arctan(b / h)
+    disp = z * np.sin(0.5 * eta) + b * (1 - np.cos(0.5 * eta))
+    case = {
+        "run": {"duration": duration, "record_interval": 0.02},
+        "damping": {"local": 0.8},
+        "specimen": {"type": "block", "width": b, "height": h, "length": 0.8, "kn": 2 * 1.8e9 / h, "friction_angle_deg": 80.0},
+        "loading": {"type": "pushover", "mode": "displacement", "displacement": float(disp),
+                    "velocity": float(disp) / (duration - 1.0), "rod_height": z},
+    }
+    return run_case(parse_case(case), progress=False)
+
+
+def test_rod_pushover_capacity_plot_draws_the_rod_force(result_files):
+    # The rod's force is in driven_reaction (per driven block); base_reaction sums the rod and the
+    # foundation, which balance in a quasi-static push (~0). The plotted curve must be the rod's:
+    # its peak is near the rigid capacity b / (2 z) (0.167; 8 s push, measured 0.186).
+    from rockdem.loading import capacity_curve
+    from rockdem.plots import plot_capacity
+
+    ds = load(result_files["pushover"])
+    lam, _ = capacity_curve(ds)
+    y = plot_capacity(ds).axes[0].lines[0].get_ydata()
+    np.testing.assert_array_equal(y, lam)
+    assert y.max() > 0.8 * 0.3 / (2 * 0.9)
+    assert np.abs(ds.base_reaction.values[:, 0]).max() / ds.attrs["pushover_weight"] < 0.5 * y.max()
+
+
+def _texts(fig) -> list[str]:
+    out = []
+    for ax in fig.axes:
+        out += [ax.get_title(), ax.get_xlabel(), ax.get_ylabel()]
+        if ax.get_legend():
+            out += [t.get_text() for t in ax.get_legend().get_texts()]
+    return [t for t in out if t]
+
+
+def test_titles_do_not_repeat_words_and_angles_are_in_rad(result_files):
+    # The example's block is named "block": titles said "block block". Rotations and eta are in
+    # rad in every plot (rockdem's unit for rocking_angle), never in degrees.
+    from rockdem.plots import plot_bouncing
+
+    ds = load(result_files["example"])
+    for func in (plot_history, plot_restitution, plot_bouncing):
+        for text in _texts(func(ds)):
+            words = text.lower().replace(",", " ").replace(":", " ").split()
+            assert all(a != b for a, b in zip(words, words[1:])), text
+            assert "°" not in text and "deg" not in text, text
+            if "θ [" in text:  # an angle axis (not the ratio |θ|/η [-])
+                assert "θ [rad]" in text, text
+    assert "rad" in plot_restitution(ds).axes[0].get_title()
 
 
 def test_block_dimensions_are_the_untilted_width_and_height():

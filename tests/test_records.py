@@ -1,24 +1,32 @@
 """Tests of rockdem.records: readers of ground-motion files, units, and record processing.
 
-Reference values for the shared records come from shared/data/ground-motions/SOURCES.md (computed there
-from the file contents). Integration checks compare with closed forms and the trapezoid-rule error bound.
+Reference values for the shipped records come from rockdem/data/ground-motions/SOURCES.md (computed
+there from the file contents, not from the headers). Integration checks compare with closed forms and the trapezoid-rule error bound.
 """
 
 from __future__ import annotations
 
+import argparse
+import hashlib
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rockdem.records import (
+    DATA_ENV,
+    SHIPPED_RECORDS,
     STANDARD_GRAVITY,
     GroundMotion,
     read_at2,
     read_columns,
     read_record,
     read_single_column,
-    shared_record_path,
+    record_path,
+    records_folder,
+    register_cli,
+    shipped_record,
 )
 
 NGA_HEADER = (
@@ -34,10 +42,10 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
     return path
 
 
-# ----------------------------------------------------------------------------------------- shared records
+# ---------------------------------------------------------------------------------------- shipped records
 
 # (file, npts, dt [s], PGA [g] to SOURCES.md's 4 decimals, t(PGA) [s] to its 2 decimals)
-SHARED = [
+SHIPPED = [
     ("RSN6_IMPVALL.I_I-ELC180.AT2", 5372, 0.0100, 0.2808, 2.18),
     ("elCentro.AT2", 1559, 0.0200, 0.3188, 2.02),
     ("RSN77_SFERN_PUL164.AT2", 4172, 0.0100, 1.2190, 7.75),
@@ -48,10 +56,10 @@ SHARED = [
 ]
 
 
-@pytest.mark.parametrize(("name", "npts", "dt", "pga_g", "t_pga"), SHARED, ids=[s[0] for s in SHARED])
-def test_shared_records_match_sources(name: str, npts: int, dt: float, pga_g: float, t_pga: float) -> None:
-    """Each shared file reads with the npts, dt, PGA and time of PGA listed in SOURCES.md."""
-    gm = read_record(shared_record_path(name), units="g" if name.endswith(".csv") else None)
+@pytest.mark.parametrize(("name", "npts", "dt", "pga_g", "t_pga"), SHIPPED, ids=[s[0] for s in SHIPPED])
+def test_shipped_records_match_sources(name: str, npts: int, dt: float, pga_g: float, t_pga: float) -> None:
+    """Each shipped file reads with the npts, dt, PGA and time of PGA listed in SOURCES.md."""
+    gm = read_record(record_path(name), units="g" if name.endswith(".csv") else None)
     assert gm.npts == npts
     assert gm.units_in == "g"
     # Header dt is exact; the CSV's dt is the mean step of a printed time column (float noise ~1e-15).
@@ -66,24 +74,115 @@ def test_shared_records_match_sources(name: str, npts: int, dt: float, pga_g: fl
 
 def test_header_text_and_units_are_kept() -> None:
     """The AT2 description comes from the header, in the NGA and the Peknold variants."""
-    assert "El Centro Array #9" in read_at2(shared_record_path("RSN6_IMPVALL.I_I-ELC180.AT2")).description
-    assert "Peknold" in read_at2(shared_record_path("elCentro.AT2")).description
+    assert "El Centro Array #9" in read_at2(record_path("RSN6_IMPVALL.I_I-ELC180.AT2")).description
+    assert "Peknold" in read_at2(record_path("elCentro.AT2")).description
 
 
-def test_shared_record_path_env_and_missing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """ROCKDEM_DATA redirects the lookup (folder or its parent); missing names list what exists."""
-    folder = tmp_path / "ground-motions"
-    folder.mkdir()
-    (folder / "x.AT2").write_text("")
-    monkeypatch.setenv("ROCKDEM_DATA", str(tmp_path))
-    assert shared_record_path("x.AT2") == folder / "x.AT2"
-    monkeypatch.setenv("ROCKDEM_DATA", str(folder))
-    assert shared_record_path("x.AT2") == folder / "x.AT2"
-    with pytest.raises(FileNotFoundError, match=r"available: x\.AT2"):
-        shared_record_path("nope.AT2")
-    monkeypatch.setenv("ROCKDEM_DATA", str(tmp_path / "absent"))
-    with pytest.raises(FileNotFoundError, match="ROCKDEM_DATA"):
-        shared_record_path("x.AT2")
+def _sources_sha256() -> dict[str, str]:
+    """file name -> SHA-256 as written in the shipped SOURCES.md (its per-file provenance sections)."""
+    text = (records_folder() / "SOURCES.md").read_text(encoding="utf-8")
+    out: dict[str, str] = {}
+    for section in re.split(r"^### ", text, flags=re.M)[1:]:
+        files = re.findall(r"[\w.-]+\.(?:AT2|csv)", section.splitlines()[0])
+        if len(files) == 1:  # "- SHA-256: `<hex>`"
+            out[files[0]] = re.search(r"SHA-256: `([0-9a-f]{64})`", section).group(1)
+        else:  # the three Irpinia files share a section: "  - BAG270: `<hex>`"
+            for tag, digest in re.findall(r"- (\w+): `([0-9a-f]{64})`", section):
+                out[next(f for f in files if f"-{tag}." in f)] = digest
+    return out
+
+
+def test_shipped_files_are_the_sources_byte_for_byte() -> None:
+    """Every shipped file's SHA-256 equals the value in SOURCES.md and in the registry; nothing else ships."""
+    listed = _sources_sha256()
+    assert len(listed) == len(SHIPPED_RECORDS) == len(SHIPPED) == 7
+    for rec in SHIPPED_RECORDS:
+        digest = hashlib.sha256((records_folder() / rec.file).read_bytes()).hexdigest()
+        assert digest == listed[rec.file] == rec.sha256, rec.file
+    data = {p.name for p in records_folder().iterdir() if p.suffix in (".AT2", ".csv")}
+    assert data == {r.file for r in SHIPPED_RECORDS}
+
+
+def test_the_irpinia_records_are_provisional() -> None:
+    """SOURCES.md says to treat the three Irpinia records as provisional: the registry says so too."""
+    prov = {r.name for r in SHIPPED_RECORDS if r.provisional}
+    assert prov == {"bagnoli", "calitri", "sturno"}
+    assert all("Irpinia" in r.event and "PROVISIONAL" in r.licence for r in SHIPPED_RECORDS if r.provisional)
+    assert "Treat these three as provisional" in (records_folder() / "SOURCES.md").read_text(encoding="utf-8")
+    assert "provisional" in (records_folder() / "README.md").read_text(encoding="utf-8")
+
+
+def test_shipped_records_need_no_folder_beside_the_package() -> None:
+    """The shipped folder lies inside the installed package, not beside a repository."""
+    import rockdem
+
+    package = Path(rockdem.__file__).resolve().parent
+    assert records_folder().resolve().is_relative_to(package)
+
+
+@pytest.mark.parametrize("rec", SHIPPED_RECORDS, ids=[r.name for r in SHIPPED_RECORDS])
+def test_records_by_short_name_and_file_name(rec, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A short name (any case) and the file name read the same record, units from the registry."""
+    monkeypatch.delenv(DATA_ENV, raising=False)
+    by_name = read_record(rec.name.upper())
+    by_file = read_record(rec.file)
+    assert shipped_record(rec.name) is shipped_record(rec.file) is rec
+    assert by_name.source == by_file.source == records_folder() / rec.file
+    np.testing.assert_array_equal(by_name.acceleration, by_file.acceleration)
+    assert by_name.units_in == rec.units
+
+
+def test_record_lookup_order(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Path first, then $ROCKDEM_DATA (the folder or its ground-motions sub-folder), then shipped."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv(DATA_ENV, raising=False)
+    shipped = records_folder() / "elCentro.AT2"
+    assert record_path("elCentro.AT2") == shipped
+    own = tmp_path / "data" / "ground-motions"
+    own.mkdir(parents=True)
+    (own / "elCentro.AT2").write_text("x")
+    (own / "mine.AT2").write_text("x")
+    monkeypatch.setenv(DATA_ENV, str(tmp_path / "data"))
+    assert record_path("elCentro.AT2") == own / "elCentro.AT2"  # the user's folder first
+    assert record_path("elcentro-peknold") == shipped  # short names are the shipped records'
+    monkeypatch.setenv(DATA_ENV, str(own))
+    assert record_path("mine.AT2") == own / "mine.AT2"
+    (tmp_path / "elCentro.AT2").write_text("x")
+    assert record_path("elCentro.AT2") == Path("elCentro.AT2")  # a file in the working folder first
+    with pytest.raises(FileNotFoundError, match=r"elcentro-rsn6.*mine\.AT2"):
+        record_path("nope.AT2")  # lists the shipped names and the user's files
+    with pytest.raises(FileNotFoundError, match="record file not found"):
+        record_path("sub/elCentro.AT2")  # a path with a folder is not looked up elsewhere
+    monkeypatch.setenv(DATA_ENV, str(tmp_path / "absent"))
+    with pytest.raises(FileNotFoundError, match=DATA_ENV):
+        record_path("elcentro-rsn6")  # a mistyped ROCKDEM_DATA is an error, not silently ignored
+
+
+def _cli(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="rockdem")
+    register_cli(parser.add_subparsers())
+    args = parser.parse_args(argv)
+    return int(args.func(args))
+
+
+def test_records_command_lists_values_read_from_the_files(capsys: pytest.CaptureFixture[str]) -> None:
+    """`rockdem records`: one row per record, with dt, npts and PGA read from the files (SOURCES.md
+    values), and the provisional flag."""
+    assert _cli(["records"]) == 0
+    out = capsys.readouterr().out
+    rows = {line.split()[0]: line for line in out.splitlines() if line.split() and shipped_record(line.split()[0])}
+    assert len(rows) == 7
+    for name, npts, dt, pga_g, _ in SHIPPED:
+        rec = shipped_record(name)
+        line = rows[rec.name]
+        assert rec.file in line and f" {npts} " in line and f"{pga_g:.4f}" in line and f" {dt:.4g} " in line
+        assert line.rstrip().endswith("YES" if rec.provisional else "no")
+    assert "Provisional" in out
+    assert _cli(["records", "sturno"]) == 0
+    detail = capsys.readouterr().out
+    assert "PROVISIONAL" in detail and "checksum    matches SOURCES.md" in detail
+    with pytest.raises(ValueError, match="short names: elcentro-rsn6"):
+        _cli(["records", "nope"])
 
 
 # ------------------------------------------------------------------------------------------- AT2 parsing

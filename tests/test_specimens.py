@@ -196,6 +196,44 @@ def test_bad_input_names_the_field(call, field):
         call(ModelBuilder())
 
 
+@pytest.mark.parametrize(
+    "call,field",
+    [
+        # heights = [-1, 1]: the mean height (the joint spacing of kn = E / l) was 0: ZeroDivisionError
+        (lambda b: stacked_blocks(b, width=0.2, length=1.0, heights=[-1.0, 1.0], material=MORTAR), r"heights\[0\]"),
+        (lambda b: stacked_blocks(b, width=0.2, length=1.0, heights="abc", material=MORTAR), "heights"),
+        (lambda b: stacked_blocks(b, width=0.2, length=1.0, heights=[1.0], material="mortar"), "material"),
+        # 10**9 courses or 1 um bricks: the builders looped for hours; refused before any block is made
+        (lambda b: brick_wall(b, courses=10**9, bricks_per_course=2, joint=MORTAR), "courses x bricks_per_course"),
+        (lambda b: parapet(b, height=1.0, length=1.0, brick=(1e-6, 1e-6), material=MORTAR), "brick"),
+        (lambda b: brick_wall(b, courses=2, bricks_per_course=2, points=(2, 10**12 + 1), joint=MORTAR), "points"),
+        (lambda b: facade(b, edge_radius=0.01, edge_facets=10**9, material=MORTAR), "edge_facets"),
+        (lambda b: facade(b, rocking_velocity="fast", material=MORTAR), "rocking_velocity"),
+        (lambda b: parapet(b, height=1.0, length=1.0, bond=5, material=MORTAR), "bond"),
+    ],
+)
+def test_absurd_or_mistyped_input_is_refused_before_building(call, field):
+    b = ModelBuilder()
+    with pytest.raises(ValueError, match=field):
+        call(b)
+    assert b.block_names() == [] or len(b.block_names()) <= 1  # nothing (or only the foundation) built
+
+
+@pytest.mark.parametrize(
+    "key,value,field",
+    [
+        ("heights", [-1.0, 1.0], r"heights must be .*heights\[0\] = -1.0"),
+        ("heights", [0.0, 0.0], r"heights\[0\] = 0.0"),
+        ("heights", [0.001] * 20_000, "20000 blocks, above the limit"),
+        ("points_across", 10**12, "points_across = 1000000000000 exceeds the limit of 10000"),
+    ],
+)
+def test_toml_stack_refuses_bad_heights_and_point_counts(key, value, field):
+    data = {"run": {"duration": 0.1}, "specimen": {"type": "stack", **CASES["stack"], key: value}}
+    with pytest.raises(ValueError, match=field):
+        parse_case(data)
+
+
 def _wall_case(**loading):
     return {
         "run": {"duration": 0.7, "record_interval": 0.005},

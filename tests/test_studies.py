@@ -1,7 +1,8 @@
-"""Studies (issue 5): specs, store, executors (serial, process pool, Dask), resume, calibration."""
+"""Studies: specs, store, executors (serial, process pool, Dask), resume, calibration, input checks, stopping."""
 
 from __future__ import annotations
 
+import os
 import pickle
 import signal
 import subprocess
@@ -212,3 +213,118 @@ def test_calibration_of_two_parameters_against_csv_and_netcdf_references(base, t
     assert np.allclose(np.interp(ref.time, nc.time, nc.value), ref.value, atol=1e-9)
     with pytest.raises(ValueError, match="quantity"):
         load_reference(csv, quantity="velocity")
+
+
+@pytest.mark.parametrize(
+    "study,message",
+    [
+        ({"set": 5}, r"\[study\] set must be a table"),  # TypeError before
+        ({"workers": 0}, r"\[study\] workers must be an integer >= 1"),  # silently all cores before
+        ({"history_interval": -1.0}, r"\[study\] history_interval \[s\] must be a positive number"),
+        ({"grid": 5}, r"grid must be a table"),
+        ({"random": {"n": 10**9, "damping.alpha": [1.0, 2.0]}}, "exceed the limit of 100000"),  # MemoryError before
+        ({"set": {"specimen.width": -1.0}}, r"first run is not a valid case: \[specimen\] width must be positive"),
+    ],
+)
+def test_study_inputs_are_refused_naming_the_key(tmp_path, capsys, study, message):
+    from rockdem.cli import main
+    from rockdem.studies import check_first_run, parse_study
+
+    data = {"study": {"base": "free-rocking", "duration": 0.01, "executor": "serial", **study}}
+    with pytest.raises(ValueError, match=message):
+        check_first_run(parse_study(data).specs)
+    f = tmp_path / "s.toml"
+    f.write_text(f'[study]\nbase = "free-rocking"\nduration = 0.01\nexecutor = "serial"\n'
+                 + "".join(f"{k} = {_toml(v)}\n" for k, v in study.items()))
+    assert main(["sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "rockdem sweep: error:" in err
+
+
+def _toml(v):
+    if isinstance(v, dict):
+        return "{" + ", ".join(f'"{k}" = {_toml(x)}' for k, x in v.items()) + "}"
+    return repr(v) if not isinstance(v, list) else "[" + ", ".join(_toml(x) for x in v) + "]"
+
+
+@pytest.mark.parametrize(
+    "argv,flag",
+    [
+        (["sweep", "S", "--workers", "0"], "--workers"),
+        (["calibrate", "REF", "--bounds", "0.001", "0.01", "--scan", "0"], "--scan"),  # silently 3 before
+        (["calibrate", "REF", "--bounds", "0.001", "0.01", "--duration", "-1"], "--duration"),
+        (["fragility", "REC", "--drift-limit", "-1"], "--drift-limit"),  # ran the whole IDA before
+        (["fragility", "REC", "--drift-limit", "nan"], "--drift-limit"),
+    ],
+)
+def test_study_command_flags_are_checked(tmp_path, capsys, argv, flag):
+    from rockdem.cli import main
+
+    argv = [str(tmp_path / a) if a in ("S", "REF", "REC") else a for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"argument {flag}" in err and "Traceback" not in err
+
+
+def _children(pid: int) -> list[int]:
+    """Live child processes of ``pid`` (Linux /proc)."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                fields = open(f"/proc/{entry}/stat").read().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid and fields[0] != "Z":
+                out.append(int(entry))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("sig", ["SIGKILL", "SIGTERM"])
+def test_killed_sweep_leaves_no_worker_running(tmp_path, sig):
+    """Pool workers end with their parent: SIGKILL (workers watch the parent's sentinel) or SIGTERM
+    (the parent stops the pool, keeps the finished rows and exits 143). Before, they ran on orphaned."""
+    f = tmp_path / "s.toml"
+    f.write_text(textwrap.dedent("""
+        [study]
+        base = "free-rocking"
+        duration = 300.0
+        executor = "process"
+        workers = 2
+        set = { "run.record_interval" = 0.05 }
+        [study.grid]
+        "damping.alpha" = [1.0, 2.0, 3.0, 4.0]
+    """))
+    proc = subprocess.Popen([sys.executable, "-m", "rockdem.cli", "sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    workers: list[int] = []
+    try:
+        deadline = time.time() + 120
+        while time.time() < deadline and len(workers) < 2:
+            workers = [p for p in _children(proc.pid) if "spawn_main" in open(f"/proc/{p}/cmdline").read()]
+            time.sleep(0.1)
+        assert len(workers) == 2, "the pool did not start"
+        proc.send_signal(getattr(signal, sig))
+        proc.wait(timeout=60)
+        deadline = time.time() + 30
+        while time.time() < deadline and any(_alive(p) for p in workers):
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in workers), "pool workers outlived the sweep"
+        if sig == "SIGTERM":
+            assert proc.returncode == 128 + signal.SIGTERM
+            assert "finished runs are kept in" in proc.stderr.read()
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for p in workers:
+            if _alive(p):
+                os.kill(p, signal.SIGKILL)

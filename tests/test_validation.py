@@ -1,6 +1,8 @@
 """Bad input gives a clear error naming the field and the fix."""
 
 import math
+import os
+import warnings
 
 import numpy as np
 
@@ -101,3 +103,145 @@ def test_divergence_check_cuts_a_blown_up_run_and_passes_a_sound_one():
     bad = ds.copy(deep=True)
     bad["block_position"].values[k + 3, 1, 0] = np.nan
     assert first_diverged_frame(bad) == k + 3
+
+
+# -- materials, damping and builder arguments check themselves (every path: API, case files, defaults)
+@pytest.mark.parametrize(
+    "kwargs,field",
+    [
+        ({"kn": math.nan}, "kn"),  # ran forever at t = 0 before
+        ({"kn": 0.0}, "kn"),
+        ({"kn": math.inf}, "kn"),
+        ({"kn": "1e9"}, "kn"),
+        ({"kn": None}, "kn"),
+        ({"kn": 1e9, "ks": -1.0}, "ks"),
+        ({"kn": 1e9, "cohesion": -1.0}, "cohesion"),
+        ({"kn": 1e9, "tension": math.nan}, "tension"),
+        ({"kn": 1e9, "friction_angle": "30"}, "friction_angle"),
+    ],
+)
+def test_joint_material_is_checked_on_construction(kwargs, field):
+    with pytest.raises(ValueError, match=rf"JointMaterial: {field} must be"):
+        JointMaterial(**kwargs)
+
+
+def test_default_material_must_be_a_material():
+    b = ModelBuilder()
+    with pytest.raises(ValueError, match="default_material must be a JointMaterial"):
+        b.default_material = {"kn": 1e9}
+    b.default_material = JointMaterial(kn=1e9)
+    assert b.default_material.kn == 1e9
+
+
+@pytest.mark.parametrize("kwargs,field", [({"alpha": -1.0}, "alpha"), ({"beta": math.nan}, "beta"), ({"alpha": "x"}, "alpha"),
+                                          ({"alpha_relative": "yes"}, "alpha_relative")])
+def test_damping_is_checked_on_construction(kwargs, field):
+    with pytest.raises(ValueError, match=f"damping.{field}"):
+        Damping(**kwargs)
+
+
+@pytest.mark.parametrize(
+    "call,message",
+    [
+        (lambda b: b.add_box("0.2", 1, 1), r"b \(width, x\) must be a positive length"),
+        (lambda b: b.add_box(0.2, 1, 1, density="heavy"), "density must be positive"),
+        (lambda b: b.add_box(0.2, 1, 1, base_center=(0, 0)), "base_center"),
+        (lambda b: b.add_box(0.2, 1, 1, velocity=(1, 2)), "velocity"),
+        (lambda b: b.add_box(0.2, 1, 1, points=(10**12, 2)), "points per face exceed the limit of 10000"),
+        (lambda b: b.add_block("box"), "poly must be a Polyhedron"),
+        (lambda b: b.tilt("nope", 0.5), "tilt: give a block name or id"),
+        (lambda b: b.tilt("ground", 0.5), "driven"),
+        (lambda b: b.set_material("a", "b", None), "material must be a JointMaterial"),
+        (lambda b: b.set_ground_motion("quake"), "give a Motion"),
+        (lambda b: b.set_body_acceleration([0, 1], [[1, 0]]), r"acceleration \(n, 3\) must match"),
+    ],
+)
+def test_builder_arguments_are_checked(call, message):
+    b = _builder()
+    b.add_box(0.2, 1, 1, name="block")
+    with pytest.raises(ValueError, match=message):
+        call(b)
+
+
+def test_tilt_fraction_is_bounded_by_lying_flat():
+    b = _builder()
+    b.add_box(0.2, 1, 1, name="block")
+    with pytest.raises(ValueError, match="tilts the blocks by 90 deg or more"):
+        b.tilt("block", 1e300)
+
+
+# -- case files: what is read, and numbers beyond reason
+def _case_text() -> str:
+    return '[run]\nduration = 0.01\n[specimen]\ntype = "block"\nwidth = 0.2\nheight = 1.0\nyoungs_modulus = 1e9\n'
+
+
+def test_case_file_that_is_not_a_regular_file_is_refused_without_reading(tmp_path):
+    from rockdem.case import load_case
+
+    fifo = tmp_path / "case.fifo"
+    os.mkfifo(fifo)  # opening it for reading would block forever
+    for path, message in ((tmp_path, "is a folder"), (fifo, "not a regular file"), ("/dev/zero", "not a regular file")):
+        with pytest.raises(ValueError, match=message):
+            load_case(path)
+    with pytest.raises(ValueError, match="give a file path"):
+        load_case(None)
+
+
+def test_case_file_encoding_size_and_nesting(tmp_path):
+    from rockdem.case import load_case
+
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + _case_text().encode())  # written by Windows Notepad: accepted
+    assert load_case(bom)["specimen"]["width"] == 0.2
+    latin = tmp_path / "latin.toml"
+    latin.write_bytes(b"# caf\xe9\n" + _case_text().encode())
+    with pytest.raises(ValueError, match=r"not UTF-8 text \(byte 0xe9 at offset 5\)"):
+        load_case(latin)
+    big = tmp_path / "big.toml"
+    big.write_bytes(b"#" * (9 * 1024**2))
+    with pytest.raises(ValueError, match="larger than 8 MiB"):
+        load_case(big)
+    deep = tmp_path / "deep.toml"
+    deep.write_text("a = " + "{b = " * 500 + "1" + "}" * 500 + "\n")  # RecursionError before
+    with pytest.raises(ValueError, match="nested too deeply"):
+        load_case(deep)
+
+
+@pytest.mark.parametrize(
+    "table,key,value,message",
+    [
+        ("specimen", "height", 1e300, r"height = 1e\+300 is beyond any plausible value"),
+        ("specimen", "points_across", 10**12, "exceeds the limit of 10000"),  # MemoryError before
+        ("loading", "tilt_direction", ["1", "0", "0"], "tilt_direction must be a list of 3 numbers"),
+        ("run", "record_interval", 5.0, r"record_interval \(5 s\) exceeds the simulated time"),
+    ],
+)
+def test_absurd_case_values_are_refused_before_the_run(table, key, value, message):
+    from rockdem.run_cli import run_case
+
+    data = example_case("free-rocking")
+    data["run"]["duration"] = 0.01
+    data[table][key] = value
+    with pytest.raises(ValueError, match=message):
+        run_case(parse_case(data))
+
+
+def test_peak_ground_acceleration_is_checked_for_plausibility(tmp_path):
+    rec = tmp_path / "r.at2"
+    rec.write_text("PEER NGA STRONG MOTION DATABASE RECORD\nsynthetic\nACCELERATION TIME SERIES IN UNITS OF G\n"
+                   "NPTS=   5, DT=   .0100 SEC\n 0.0 0.1 -0.1 0.05 0.0\n")
+    data = example_case("free-rocking")
+    data["loading"] = {"type": "earthquake", "record": str(rec), "mode": "inertial", "pga_g": 1e6}
+    with pytest.raises(ValueError, match=r"pga_g = 1000000.0 is not plausible"):
+        parse_case(data)
+    data["loading"]["pga_g"] = 20.0
+    with pytest.warns(UserWarning, match=r"pga_g = 20.0 is above 5"):
+        parse_case(data)
+    data["loading"]["pga_g"] = 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parse_case(data)
+    del data["loading"]["pga_g"]
+    data["loading"]["scale"] = 1e4  # the record's 0.1 g peak becomes ~1000 g (after baseline correction)
+    with pytest.raises(ValueError, match=r"scaled record's peak ground acceleration \[g\] \(see scale\) = \d+\.?\d* is not plausible"):
+        parse_case(data)

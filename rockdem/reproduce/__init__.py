@@ -1,4 +1,4 @@
-"""The paper's studies reproduced: ``rockdem reproduce NAME`` (DESIGN §5; Galvez et al. 2022).
+"""The paper's studies reproduced: ``rockdem reproduce NAME`` (Galvez et al. 2022).
 
 Each study is a function ``study(ctx) -> Report`` registered with :func:`reproduction`. It runs its
 simulations through :meth:`Context.execute` (a :mod:`rockdem.studies` sweep with a resumable store

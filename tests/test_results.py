@@ -1,0 +1,131 @@
+"""Results: displacements relative to the ground (absolute kept, both labelled) and safe saving."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from rockdem.loading import apply_earthquake
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, ModelBuilder
+from rockdem.records import read_record
+from rockdem.results import export_csv, load, save
+from rockdem.simulate import simulate
+
+B, H, RHO, E = 0.2, 1.0, 1800.0, 1.8e9
+
+
+def _earthquake_run(mode: str) -> xr.Dataset:
+    """A 0.2 x 1 m block under 1.5 s of El Centro (record 1.0-2.5 s, around its 2.18 s peak)."""
+    bld = ModelBuilder(points=(2, 2))
+    bld.default_material = JointMaterial(kn=E / H, friction_angle=80.0)
+    bld.add_box(2.0, 2.0, 0.5, base_center=(0, 0, -0.5), driven="ground", name="foundation", points=(2, 2))
+    bld.add_box(B, 0.5, H, density=RHO, name="block")
+    apply_earthquake(bld, read_record("elcentro-rsn6"), mode=mode, window=(1.0, 2.5))
+    beta = 2.0 / math.sqrt(E * B / (RHO * H * H))
+    model = bld.finalize(damping=Damping(beta=beta))
+    return simulate(model, 1.5, monitors={"top": ("block", (B / 2, 0.0, H))}, record_interval=0.005, progress=False)
+
+
+@pytest.fixture(scope="module")
+def runs() -> dict[str, xr.Dataset]:
+    return {mode: _earthquake_run(mode) for mode in ("foundation", "inertial")}
+
+
+def test_displacements_are_relative_to_the_ground_by_default(runs):
+    # Foundation mode moves the ground-driven foundation with the record's displacement (here tens
+    # of mm); the response relative to the ground is frame invariant: it equals the inertial-mode
+    # response (fixed foundation). The difference of the two frames is O(substep) (see
+    # tests/test_loading.py); tolerance 2 % of the peak relative displacement.
+    fnd, ine = runs["foundation"], runs["inertial"]
+    ug = fnd.ground_displacement.values
+    assert np.abs(ug[:, 0]).max() > 0.01  # the ground really moved
+    rel = fnd.monitor_displacement.values[:, 0, 0]
+    ref = ine.monitor_displacement.values[:, 0, 0]
+    peak = np.abs(ref).max()
+    assert peak > 1e-4  # the block responded
+    assert np.abs(rel - ref).max() < 0.02 * peak
+    # absolute = relative + ground, for monitors and centroids; labels say which is which
+    np.testing.assert_allclose(fnd.monitor_displacement_absolute.values, fnd.monitor_displacement.values + ug[:, None], atol=1e-12)
+    np.testing.assert_allclose(fnd.block_displacement_absolute.values, fnd.block_displacement.values + ug[:, None], atol=1e-12)
+    assert np.abs(fnd.block_displacement.values[:, 0]).max() == 0.0  # the foundation itself is the ground
+    assert fnd.monitor_displacement.attrs["reference"] == fnd.attrs["displacement_reference"] == "ground"
+    assert fnd.monitor_displacement_absolute.attrs["reference"] == "fixed frame"
+    # inertial mode: no moving ground, relative = absolute, labelled so
+    assert ine.attrs["displacement_reference"] == "fixed frame"
+    np.testing.assert_array_equal(ine.monitor_displacement.values, ine.monitor_displacement_absolute.values)
+    # rotations do not see a translating ground
+    th_f, th_i = fnd.rocking_angle.values[:, 1], ine.rocking_angle.values[:, 1]
+    assert np.abs(th_f - th_i).max() < 0.02 * np.abs(th_i).max()
+
+
+def test_ground_displacement_is_the_records_double_integral(runs):
+    # The driven foundation follows v_g(t) (trapezoid integral of the baseline-corrected record):
+    # its displacement is the integral of v_g, to the engine's step (dt ~ 1e-5 s) accuracy.
+    fnd = runs["foundation"]
+    gm = read_record("elcentro-rsn6")
+    from rockdem.loading import prepare_record
+
+    used = prepare_record(gm, window=(1.0, 2.5))
+    t = fnd.time.values
+    expect = np.interp(t, used.time - used.time[0], used.displacement())
+    ug = fnd.ground_displacement.values[:, 0]
+    assert np.abs(ug - expect).max() < 0.01 * np.abs(expect).max()
+
+
+def test_csv_labels_relative_columns_and_adds_the_ground(runs, tmp_path):
+    path = export_csv(runs["foundation"], tmp_path / "h.csv")
+    header = path.read_text().splitlines()[0].split(",")
+    assert "top.ux rel. ground [m]" in header and "ground.ux [m]" in header and "top.ux [m]" not in header
+
+
+def _small_result() -> xr.Dataset:
+    bld = ModelBuilder(points=(2, 2))
+    bld.default_material = JointMaterial(kn=E / H, friction_angle=80.0)
+    bld.add_box(2.0, 2.0, 0.5, base_center=(0, 0, -0.5), driven=True, name="foundation")
+    bld.add_box(B, 0.5, H, density=RHO, name="block")
+    return simulate(bld.finalize(), 0.01, record_interval=0.005, progress=False)
+
+
+def test_interrupted_save_leaves_no_truncated_file(tmp_path, monkeypatch):
+    # A second Ctrl-C during the write: the destination must keep its previous content (or not
+    # exist), never hold a partial file that still opens; no temporary file is left behind.
+    ds = _small_result()
+    dest = tmp_path / "result.nc"
+    real = xr.Dataset.to_netcdf
+
+    def interrupted(self, path, *args, **kwargs):
+        real(self.isel(time=[0]), path)  # a valid but incomplete file on disk...
+        raise KeyboardInterrupt  # ...then the interruption
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        save(ds, dest)
+    assert not dest.exists()
+    dest.write_bytes(b"previous result")
+    with pytest.raises(KeyboardInterrupt):
+        save(ds, dest)
+    assert dest.read_bytes() == b"previous result"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["result.nc"]
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", real)
+    save(ds, dest)
+    assert load(dest).sizes["time"] == ds.sizes["time"]
+
+
+def test_save_replaces_a_symlink_instead_of_writing_through_it(tmp_path):
+    ds = _small_result()
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("not yours to overwrite")
+    link = tmp_path / "result.nc"
+    os.symlink(target, link)
+    save(ds, link)
+    assert target.read_text() == "not yours to overwrite"
+    assert link.is_file() and not link.is_symlink()
+    assert load(link).sizes["time"] == ds.sizes["time"]
+    with pytest.raises(ValueError, match="is a folder"):
+        save(ds, tmp_path)
