@@ -20,7 +20,7 @@ import time
 
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 from rockdem.state import initial_state
 
 BETA = 0.00693

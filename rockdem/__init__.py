@@ -19,7 +19,7 @@ __version__ = "0.1.0"
 _API = {
     "ModelBuilder": "model", "Damping": "model", "Motion": "model", "Model": "model",
     "JointMaterial": "materials", "box": "geometry", "convex_hull": "geometry",
-    "simulate": "simulate", "save": "results", "load": "results",
+    "simulate": "simulation", "save": "results", "load": "results",
     "stacked_blocks": "specimens", "brick_wall": "specimens", "parapet": "specimens",
     "facade": "specimens", "two_block_wall": "specimens",
     "apply_earthquake": "loading", "pushover": "loading", "apply_rod_pushover": "loading",

@@ -24,7 +24,7 @@ from .geometry import MAX_FACE_POINTS
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
-from .simulate import Monitor
+from .simulation import Monitor
 
 __all__ = [
     "Table",
@@ -209,12 +209,13 @@ def check_plausible(value: float, what: str, key: str = "") -> None:
 
 @dataclass(frozen=True)
 class RunOptions:
-    """``simulate()`` options from ``[run]`` (see :func:`rockdem.simulate.simulate`)."""
+    """``simulate()`` options from ``[run]`` (see :func:`rockdem.simulation.simulate`)."""
 
     duration: float
     dt: float | None = None
     timestep_rule: str = "bound"
     safety: float = 0.9
+    resolution: float = 0.3
     record_interval: float = 0.002
     contact_tolerance: float | None = None
 
@@ -466,6 +467,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         dt=run_t.optional_number("dt", positive=True),
         timestep_rule=run_t.string("timestep_rule", "bound", choices=("bound", "3dec")),
         safety=run_t.number("safety", 0.9, positive=True),
+        resolution=run_t.number("resolution", 0.3, positive=True),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
     )

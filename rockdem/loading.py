@@ -46,7 +46,7 @@ from .case import Table, loading
 from .geometry import box, mass_properties
 from .model import GROUND, Damping, ModelBuilder, Motion
 from .records import STANDARD_GRAVITY, GroundMotion, read_record, record_path
-from .simulate import Monitor, simulate
+from .simulation import Monitor, simulate
 
 __all__ = [
     "EARTHQUAKE_MODES",

@@ -8,6 +8,7 @@ validates everything once and freezes it into a :class:`Model` of flat arrays
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
@@ -534,6 +535,7 @@ class ModelBuilder:
         geometry = flatten_geometry(frames)
 
         free_mask = np.array([blk.driven is False for blk in self._blocks])
+        _warn_implausible_units(self._blocks, mats, min_dim)
         if contact_tolerance is None:
             # a bonded point must stay tracked until its bond breaks: at least 1.5 x the elastic
             # opening at the tensile strength (ft / kn) and slip at the cohesion (c / ks)
@@ -655,3 +657,32 @@ def _vector3(value: ArrayLike, what: str) -> NDArray[np.float64]:
     if v.shape != (3,) or not np.all(np.isfinite(v)):
         raise ValueError(f"{what} must be a finite 3-vector (x, y, z), got {value!r}")
     return v
+
+
+#: Below these, a value is almost surely in the wrong unit (masonry: 1500-2500 kg/m^3, E >= 1 MPa).
+PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
+PLAUSIBLE_MODULUS = 1e6  # [Pa]
+
+
+def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointMaterial], size: float) -> None:
+    """Warn about a density or a joint stiffness that looks given in t/m3 or MPa (SI is expected).
+
+    The joint stiffness is compared as the modulus it implies over the smallest free block
+    dimension ``size`` [m] (kn = E / l, paper Eq. 12).
+    """
+    for blk in blocks:
+        if blk.driven is False and blk.density < PLAUSIBLE_DENSITY:
+            warnings.warn(
+                f"block {blk.name!r}: density {blk.density:g} kg/m^3 is lighter than any masonry "
+                f"(1500-2500 kg/m^3); if it is in t/m3, give it x 1000 (SI units: kg/m^3)", UserWarning, stacklevel=3,
+            )
+            break
+    for (ga, gb), mat in mats.items():
+        modulus = mat.kn * size
+        if modulus < PLAUSIBLE_MODULUS:
+            warnings.warn(
+                f"joint {ga!r}-{gb!r}: kn = {mat.kn:g} N/m^3 implies a youngs_modulus of about kn x {size:g} m = "
+                f"{modulus:g} Pa, below 1 MPa; moduli are in Pa (1.8 GPa is 1.8e9), not MPa", UserWarning, stacklevel=3,
+            )
+            break
+

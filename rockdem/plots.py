@@ -1,5 +1,5 @@
 """Plots of results, after the figures of Galvez et al. (2022): each function takes a result
-(an xarray Dataset from :func:`rockdem.simulate.simulate` or a NetCDF path) and returns a
+(an xarray Dataset from :func:`rockdem.simulation.simulate` or a NetCDF path) and returns a
 Matplotlib :class:`~matplotlib.figure.Figure` (Agg, never shown).
 
 - :func:`plot_history`: rocking angle and normalised top displacement u/B vs time (Figs. 6, 9B, 10B, 12B, 13);

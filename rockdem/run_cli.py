@@ -15,7 +15,7 @@ import xarray as xr
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, stop_on_signals
 from .results import export_csv, save
-from .simulate import simulate
+from .simulation import simulate
 
 __all__ = ["run_case", "register_cli", "summary_lines"]
 
@@ -36,6 +36,7 @@ def run_case(case: Case, *, duration: float | None = None, progress: bool | None
         dt=r.dt,
         timestep_rule=r.timestep_rule,
         safety=r.safety,
+        resolution=r.resolution,
         record_interval=r.record_interval,
         monitors=case.monitors,
         progress=progress,

@@ -1,4 +1,4 @@
-"""Sub-contact snapshots taken by :func:`rockdem.simulate.simulate` at chunk boundaries.
+"""Sub-contact snapshots taken by :func:`rockdem.simulation.simulate` at chunk boundaries.
 
 When ``simulate(..., contact_interval=dt_c)`` is given, the state of every interface point is
 copied every ``dt_c`` seconds (the loop's chunks are cut to land on these times) and added to the

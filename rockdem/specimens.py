@@ -2,7 +2,7 @@
 
 Each builder adds blocks (and the joint materials between its groups) to a
 :class:`~rockdem.model.ModelBuilder` and returns monitors ``{name: (block name, world point in the
-reference configuration [m])}`` for :func:`rockdem.simulate.simulate`. Each has a TOML form
+reference configuration [m])}`` for :func:`rockdem.simulation.simulate`. Each has a TOML form
 (``[specimen] type = ...``) registered here with :func:`rockdem.case.specimen`.
 
 Conventions: SI units; z is up; the rocking direction is x (out of plane), walls run along y;
@@ -25,7 +25,7 @@ from .geometry import Polyhedron, box, convex_hull, mass_properties
 from .kernels.rotation import axis_angle_matrix
 from .materials import JointMaterial, real_number
 from .model import GROUND, Motion, ModelBuilder
-from .simulate import Monitor
+from .simulation import Monitor
 
 __all__ = [
     "stacked_blocks",

@@ -141,4 +141,5 @@ def stable_timestep(
         w = math.sqrt(k_max / m_min)
         f3 = sp_critical_factor(float(np.max(m.mat_beta)), w)
         return TimestepInfo(0.2 * math.sqrt(m_min / k_max) * f3, critical, om, f3, "3dec")
-    return TimestepInfo(min(safety * critical, resolution * 2.0 / om), critical, om, fac, "bound", resolution)
+    accurate = resolution * 2.0 / om if om > 0.0 else math.inf
+    return TimestepInfo(min(safety * critical, accurate), critical, om, fac, "bound", resolution)

@@ -82,7 +82,7 @@ def test_summary_is_an_aligned_table_with_units(tmp_path, capsys):
 def test_summary_survives_a_run_stopped_at_zero_or_one_frame():
     from conftest import rocking_block
     from rockdem.run_cli import summary_lines
-    from rockdem.simulate import simulate
+    from rockdem.simulation import simulate
 
     ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.02, record_interval=0.01)
     for n in (0, 1):  # a run that diverges at t = 0 keeps 0 or 1 frames: IndexError before
@@ -118,21 +118,21 @@ def test_stop_signals_save_the_frames_computed_so_far(tmp_path, capsys, monkeypa
     import os
     import signal
 
-    import rockdem.simulate
+    import rockdem.simulation
 
     sig = getattr(signal, name, None)
     if sig is None:
         pytest.skip(f"no {name} on this platform")
-    real, calls = rockdem.simulate.advance, []
+    real, calls = rockdem.simulation.advance, []
 
     def advance(*args):
-        frame = real(*args)
+        frame, status = real(*args)
         calls.append(frame)
         if len(calls) == 2:
             os.kill(os.getpid(), sig)  # delivered in the loop, between two compiled chunks
-        return frame
+        return frame, status
 
-    monkeypatch.setattr(rockdem.simulate, "advance", advance)
+    monkeypatch.setattr(rockdem.simulation, "advance", advance)
     code = main(["run", "--example", "free-rocking", "--out", str(tmp_path), "--duration", "60", "--quiet", "--no-plot"])
     assert code == 128 + sig
     assert "INTERRUPTED" in capsys.readouterr().out

@@ -19,7 +19,7 @@ from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.records import read_record
 from rockdem.run_cli import run_case
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 B, H, L, RHO, E = 0.2, 2.0, 1.0, 1800.0, 1.8e9  # the §3.3 block

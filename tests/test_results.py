@@ -15,7 +15,7 @@ from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.records import read_record
 from rockdem.results import export_csv, load, save
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 
 B, H, RHO, E = 0.2, 1.0, 1800.0, 1.8e9
 

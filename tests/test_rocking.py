@@ -10,7 +10,7 @@ from conftest import peaks, restitution, rocking_block
 from rockdem.kernels.rotation import axis_angle_matrix
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 
 
 def housner_quarter_period(b: float, h: float, theta0: float) -> float:

@@ -8,7 +8,7 @@ import pytest
 from rockdem.kernels.rotation import axis_angle_matrix
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 
 
 def test_static_settlement_and_base_reaction():

@@ -12,7 +12,7 @@ from conftest import rocking_block
 from rockdem.case import example_case, parse_case
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 from rockdem.timestep import stable_timestep
 
 
@@ -92,7 +92,7 @@ def test_divergence_check_cuts_a_blown_up_run_and_passes_a_sound_one():
     # A sound run keeps its energy balance (error ~1e-3 of the energy scale): no divergence. A run
     # whose balance breaks (here injected: 50 J appear from nothing at frame k) or whose state is no
     # longer finite is cut at the first bad frame (the engine then warns and keeps the frames before).
-    from rockdem.simulate import first_diverged_frame
+    from rockdem.simulation import first_diverged_frame
 
     ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.3, record_interval=0.01)
     assert first_diverged_frame(ds) is None and "diverged" not in ds.attrs
@@ -245,3 +245,31 @@ def test_peak_ground_acceleration_is_checked_for_plausibility(tmp_path):
     data["loading"]["scale"] = 1e4  # the record's 0.1 g peak becomes ~1000 g (after baseline correction)
     with pytest.raises(ValueError, match=r"scaled record's peak ground acceleration \[g\] \(see scale\) = \d+\.?\d* is not plausible"):
         parse_case(data)
+
+
+def test_simulate_from_the_package_root_is_the_function():
+    # The package docstring advertises ``from rockdem import simulate``: it must be the function,
+    # also after the module that defines it has been imported.
+    import rockdem.simulation
+    from rockdem import simulate
+
+    assert callable(simulate) and simulate is rockdem.simulation.simulate
+    with pytest.raises(TypeError, match="Model"):
+        simulate(None, 1.0)
+
+
+def test_a_block_sinking_into_far_too_soft_joints_stops_the_run():
+    # kn = 1e5 Pa/m under a 1 m tall block: the static overlap rho g h / kn = 0.18 m is most of
+    # its 0.2 m thickness. The run stops once an overlap passes a quarter of the thinner block.
+    from rockdem.simulation import SINK_FRACTION, simulate
+
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e5, friction_angle=35)
+    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.2, 1, 1, density=1800, name="block")
+    with pytest.warns(RuntimeWarning, match="sank"):
+        ds = simulate(b.finalize(), 3.0, progress=False)
+    assert ds.attrs["diverged"] == 1 and ds.attrs["diverged_reason"] == "sank"
+    assert float(ds.time[-1]) < 3.0
+    sink = -float(ds.block_position.values[-1, 1, 2] - 0.5)
+    assert sink > SINK_FRACTION * 0.2 * 0.5  # it had sunk well into the ground when it stopped

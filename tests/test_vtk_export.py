@@ -17,7 +17,7 @@ from rockdem.cli import main
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.results import load, save
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 from rockdem.snapshots import BYTES_PER_POINT
 from rockdem.vtk_export import STATE_CODES, export_vtk
 from viz_cases import wall_model, wall_result

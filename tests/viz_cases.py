@@ -17,7 +17,7 @@ import xarray as xr
 from rockdem.case import apply_overrides, example_case, parse_case
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, Model, ModelBuilder, Motion
-from rockdem.simulate import simulate
+from rockdem.simulation import simulate
 
 WALL_BRICK = (0.2, 0.4, 0.25)  # b (rocking direction), l, h [m]
 

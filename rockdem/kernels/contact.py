@@ -92,14 +92,14 @@ def ramp_overlap(un: float, un_prev: float, vn: float, dt: float) -> float:
     return un
 
 
-# 6-point Gauss-Legendre nodes and weights on [-1, 1].
-_GL_X = (-0.9324695142031521, -0.6612093864662645, -0.2386191860831969, 0.2386191860831969, 0.6612093864662645, 0.9324695142031521)
-_GL_W = (0.1713244923791704, 0.3607615730481386, 0.4679139345726910, 0.4679139345726910, 0.3607615730481386, 0.1713244923791704)
+RELEASE_INTERVALS = 8
+"""Simpson intervals per segment for the impulse of a releasing shear spring (the profile is
+linear except where the Coulomb cap takes over)."""
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def release_shear(
-    us: np.ndarray, ks_area: float, cap_slope: float, un_prev: float, vn: float,
+    us0: float, us1: float, us2: float, ks_area: float, cap_slope: float, un_prev: float, vn: float,
     vs0: float, vs1: float, vs2: float, dt: float,
 ) -> tuple[float, float, float, float]:
     """The shear spring of an unbonded contact that opened during the last step.
@@ -109,10 +109,12 @@ def release_shear(
     falls to zero at the opening time t* = un_prev / vn (t from the previous step). The previous
     step applied F(0) over [-dt/2, dt/2]; this returns the force that completes the exact impulse
     of F over [-dt/2, t*] (a 6-point Gauss rule) and the energy dissipated in the spring from the
-    previous step to t*, E(0) - int_0^t* F . v_s dt [J].
+    previous step to t*, E(0) - int_0^t* F . v_s dt [J]. (The profile is integrated by Simpson's
+    rule with nodes computed in place: a table of nodes would be an array, which in this inlined
+    function would cost the caller's loop its reference-count pruning.)
 
     Args:
-        us: (3,) elastic extension at the previous step [m]; ks_area: ks A [N/m];
+        us0, us1, us2: elastic extension at the previous step [m]; ks_area: ks A [N/m];
         cap_slope: mu kn A [N/m]; un_prev: overlap at the previous step [m];
         vn: separation speed (> 0) [m/s]; vs: tangential relative velocity [m/s]; dt [s].
     """
@@ -120,61 +122,59 @@ def release_shear(
     imp0 = imp1 = imp2 = 0.0
     work = 0.0
     for seg in range(2):
-        a, b = (-0.5 * dt, 0.0) if seg == 0 else (0.0, t_star)
-        half = 0.5 * (b - a)
-        mid = 0.5 * (a + b)
-        for k in range(6):
-            t = mid + half * _GL_X[k]
-            e0 = ks_area * (us[0] - vs0 * t)
-            e1 = ks_area * (us[1] - vs1 * t)
-            e2 = ks_area * (us[2] - vs2 * t)
+        a = -0.5 * dt if seg == 0 else 0.0
+        b = 0.0 if seg == 0 else t_star
+        h = (b - a) / RELEASE_INTERVALS
+        for k in range(RELEASE_INTERVALS + 1):
+            t = a + k * h
+            e0 = ks_area * (us0 - vs0 * t)
+            e1 = ks_area * (us1 - vs1 * t)
+            e2 = ks_area * (us2 - vs2 * t)
             mag = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
             cap = cap_slope * max(un_prev - vn * t, 0.0)
             f = cap / mag if mag > cap else 1.0
-            w = half * _GL_W[k]
+            w = h / 3.0 * (1.0 if k == 0 or k == RELEASE_INTERVALS else (4.0 if k % 2 == 1 else 2.0))
             imp0 += w * f * e0
             imp1 += w * f * e1
             imp2 += w * f * e2
             if seg == 1:
                 work += w * f * (e0 * vs0 + e1 * vs1 + e2 * vs2)
-    f0 = ks_area * us[0]
-    f1 = ks_area * us[1]
-    f2 = ks_area * us[2]
+    f0 = ks_area * us0
+    f1 = ks_area * us1
+    f2 = ks_area * us2
     stored = 0.5 * (f0 * f0 + f1 * f1 + f2 * f2) / ks_area if ks_area > 0.0 else 0.0
     return imp0 / dt - f0, imp1 / dt - f1, imp2 / dt - f2, stored - work
 
 
 @njit(cache=True, inline="always")
 def sp_critical_factor(beta: float, omega_max: float) -> float:
-    """Timestep reduction sqrt(1 + xi^2) - xi, xi = beta omega_max / 2 (Belytschko, SP damping)."""
+    """Timestep reduction sqrt(1 + xi^2) - xi, xi = beta omega_max / 2 (Belytschko, SP damping),
+    evaluated as 1 / (sqrt(1 + xi^2) + xi), free of cancellation and overflow for large xi."""
     xi = 0.5 * beta * omega_max
-    return math.sqrt(1.0 + xi * xi) - xi
+    return 1.0 / (math.hypot(1.0, xi) + xi)
 
 
 @njit(cache=True, inline="always")
 def shear_increment(
-    us: np.ndarray, n0: float, n1: float, n2: float, vs0: float, vs1: float, vs2: float, dt: float
-) -> tuple[float, float, float, float]:
-    """Carry the elastic shear extension ``us`` (3,) [m] into the current tangent plane (normal n,
-    keeping its length) and add the relative tangential motion du = -v_s dt.
+    e0: float, e1: float, e2: float, n0: float, n1: float, n2: float, vs0: float, vs1: float, vs2: float, dt: float
+) -> tuple[float, float, float, float, float, float]:
+    """Carry the elastic shear extension e (3 components) [m] into the current tangent plane
+    (normal n, keeping its length) and add the relative tangential motion du = -v_s dt.
 
-    Returns (|e_trial|, e0 . du, |e0|^2, |du|^2) with e0 the carried extension and e_trial the new
-    ``us`` (for :func:`slip_dissipation`)."""
-    mag = math.sqrt(us[0] * us[0] + us[1] * us[1] + us[2] * us[2])
-    d = us[0] * n0 + us[1] * n1 + us[2] * n2
-    us[0] -= d * n0
-    us[1] -= d * n1
-    us[2] -= d * n2
-    mag2 = math.sqrt(us[0] * us[0] + us[1] * us[1] + us[2] * us[2])
+    Returns the new extension (3 components), e_carried . du, |e_carried|^2 and |du|^2 (the last
+    three for :func:`slip_dissipation`)."""
+    mag = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    d = e0 * n0 + e1 * n1 + e2 * n2
+    e0 -= d * n0
+    e1 -= d * n1
+    e2 -= d * n2
+    mag2 = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
     if mag2 > 0.0:
         f = mag / mag2
-        us[0] *= f
-        us[1] *= f
-        us[2] *= f
+        e0 *= f
+        e1 *= f
+        e2 *= f
     du0, du1, du2 = -vs0 * dt, -vs1 * dt, -vs2 * dt
-    e0_du = us[0] * du0 + us[1] * du1 + us[2] * du2
-    e0_sq = us[0] * us[0] + us[1] * us[1] + us[2] * us[2]
-    us[0] += du0
-    us[1] += du1
-    us[2] += du2
-    return math.sqrt(us[0] * us[0] + us[1] * us[1] + us[2] * us[2]), e0_du, e0_sq, du0 * du0 + du1 * du1 + du2 * du2
+    e0_du = e0 * du0 + e1 * du1 + e2 * du2
+    e0_sq = e0 * e0 + e1 * e1 + e2 * e2
+    return e0 + du0, e1 + du1, e2 + du2, e0_du, e0_sq, du0 * du0 + du1 * du1 + du2 * du2

@@ -194,14 +194,21 @@ class Scratch(NamedTuple):
     body_acc: np.ndarray  # (3,) [m/s^2]
     driven_velocity: np.ndarray  # (3,) [m/s] prescribed velocity of the driven block being integrated
     omega_world: np.ndarray  # (nb, 3) [rad/s]
-    dashpot_force: np.ndarray  # (SLOTS np, 3) [N] SP dashpot force on the owner, per track entry
-    dashpot_point: np.ndarray  # (SLOTS np, 3) [m] world point of that dashpot
-    pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: dashpot force on block a
-    pair_dashpot_point: np.ndarray  # (P, 3) [m]
+    contact_force: np.ndarray  # (SLOTS np, 3) [N] force of each tracked sub-contact on its owner, world
+    contact_point: np.ndarray  # (SLOTS np, 3) [m] its point of application, world
+    dashpot_force: np.ndarray  # (SLOTS np, 3) [N] the SP dashpot part of that force
+    track_cover: np.ndarray  # (SLOTS np, 3) effective area [m^2] and force point (u, w) [m] of each
+    # tracked sub-contact (owner face coordinates)
+    pending: np.ndarray  # (SLOTS np,) int64 tracked sub-contacts left for a later pass
+    pending_pair: np.ndarray  # (SLOTS np,) int64 their pairs
+    release_overlap: np.ndarray  # (SLOTS np,) [m] overlap at the previous step of each opened one
+    release_area: np.ndarray  # (SLOTS np,) [m^2] its area at the previous step
+    pair_force: np.ndarray  # (P, 3) [N] EDGE pairs: force on block a
+    pair_point: np.ndarray  # (P, 3) [m] its point of application
+    pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: the SP dashpot part
     velocity_mid: np.ndarray  # (nb, 3) [m/s] step mid-point velocity
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
-    poly_a: np.ndarray  # (16, 2) clipping buffer
-    poly_b: np.ndarray  # (16, 2) clipping buffer
+    poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
     cand_code: np.ndarray  # (C,) int64 detection: candidate point p (slot assigned later)
     cand_partner: np.ndarray  # (C,) int64
     cand_face: np.ndarray  # (C,) int64 target face

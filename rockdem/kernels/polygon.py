@@ -13,54 +13,59 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def clip_halfplane(src: np.ndarray, n: int, lu: float, lw: float, lo: float, dst: np.ndarray) -> int:
-    """Sutherland-Hodgman step: the part of polygon ``src[:n]`` inside lu x + lw y <= lo, written to
-    ``dst``; returns its vertex count (0 when nothing is left)."""
+def clip_halfplane(buf: np.ndarray, i: int, n: int, lu: float, lw: float, lo: float) -> int:
+    """Sutherland-Hodgman step: the part of polygon ``buf[i, :n]`` inside lu x + lw y <= lo, written
+    to ``buf[1 - i]``; returns its vertex count (0 when nothing is left). Buffers are addressed by
+    index (no array views are made: in Numba's compiled code a view costs reference counting)."""
+    j = 1 - i
     out = 0
-    if n == 0:
-        return 0
-    px, py = src[n - 1, 0], src[n - 1, 1]
+    last = max(n - 1, 0)
+    px = buf[i, last, 0]
+    py = buf[i, last, 1]
     dp = lu * px + lw * py - lo
-    for i in range(n):
-        cx, cy = src[i, 0], src[i, 1]
+    for q in range(n):
+        cx = buf[i, q, 0]
+        cy = buf[i, q, 1]
         dc = lu * cx + lw * cy - lo
         if dc <= 0.0:
             if dp > 0.0:
                 t = dp / (dp - dc)
-                dst[out, 0] = px + t * (cx - px)
-                dst[out, 1] = py + t * (cy - py)
+                buf[j, out, 0] = px + t * (cx - px)
+                buf[j, out, 1] = py + t * (cy - py)
                 out += 1
-            dst[out, 0] = cx
-            dst[out, 1] = cy
+            buf[j, out, 0] = cx
+            buf[j, out, 1] = cy
             out += 1
         elif dp <= 0.0:
             t = dp / (dp - dc)
-            dst[out, 0] = px + t * (cx - px)
-            dst[out, 1] = py + t * (cy - py)
+            buf[j, out, 0] = px + t * (cx - px)
+            buf[j, out, 1] = py + t * (cy - py)
             out += 1
-        px, py, dp = cx, cy, dc
+        px = cx
+        py = cy
+        dp = dc
     return out
 
 
 @njit(cache=True, inline="always")
-def polygon_area(poly: np.ndarray, n: int) -> float:
-    """Area of polygon ``poly[:n]`` (positive when counter-clockwise) [m^2]."""
+def polygon_area(buf: np.ndarray, b: int, n: int) -> float:
+    """Area of polygon ``buf[b, :n]`` (positive when counter-clockwise) [m^2]."""
     a = 0.0
     for i in range(n):
         j = i + 1 if i + 1 < n else 0
-        a += poly[i, 0] * poly[j, 1] - poly[j, 0] * poly[i, 1]
+        a += buf[b, i, 0] * buf[b, j, 1] - buf[b, j, 0] * buf[b, i, 1]
     return 0.5 * a
 
 
 @njit(cache=True, inline="always")
-def nearest_on_polygon(poly: np.ndarray, n: int, x: float, y: float) -> tuple[float, float]:
-    """Point of the boundary of polygon ``poly[:n]`` nearest to (x, y)."""
+def nearest_on_polygon(buf: np.ndarray, b: int, n: int, x: float, y: float) -> tuple[float, float]:
+    """Point of the boundary of polygon ``buf[b, :n]`` nearest to (x, y)."""
     best = np.inf
     bx, by = x, y
     for i in range(n):
         j = i + 1 if i + 1 < n else 0
-        ax, ay = poly[i, 0], poly[i, 1]
-        ex, ey = poly[j, 0] - ax, poly[j, 1] - ay
+        ax, ay = buf[b, i, 0], buf[b, i, 1]
+        ex, ey = buf[b, j, 0] - ax, buf[b, j, 1] - ay
         ee = ex * ex + ey * ey
         t = ((x - ax) * ex + (y - ay) * ey) / ee if ee > 0.0 else 0.0
         t = min(max(t, 0.0), 1.0)
@@ -73,21 +78,21 @@ def nearest_on_polygon(poly: np.ndarray, n: int, x: float, y: float) -> tuple[fl
 
 @njit(cache=True, inline="always")
 def deepest_vertex(
-    poly: np.ndarray, n: int, h0: float, hu: float, hw: float, x: float, y: float, tie: float
+    buf: np.ndarray, b: int, n: int, hu: float, hw: float, x: float, y: float, tie: float
 ) -> tuple[float, float]:
-    """Vertex of polygon ``poly[:n]`` where the affine height h0 + hu u + hw w is lowest (the
+    """Vertex of polygon ``buf[b, :n]`` where the height hu u + hw w (+ a constant) is lowest (the
     deepest overlap); vertices within ``tie`` [m] of the lowest count as equal and the one nearest
     to (x, y) is taken."""
     low = np.inf
     for i in range(n):
-        low = min(low, h0 + hu * poly[i, 0] + hw * poly[i, 1])
+        low = min(low, hu * buf[b, i, 0] + hw * buf[b, i, 1])
     best = np.inf
     bx, by = x, y
     for i in range(n):
-        if h0 + hu * poly[i, 0] + hw * poly[i, 1] <= low + tie:
-            d = (poly[i, 0] - x) ** 2 + (poly[i, 1] - y) ** 2
+        if hu * buf[b, i, 0] + hw * buf[b, i, 1] <= low + tie:
+            d = (buf[b, i, 0] - x) ** 2 + (buf[b, i, 1] - y) ** 2
             if d < best:
-                best, bx, by = d, poly[i, 0], poly[i, 1]
+                best, bx, by = d, buf[b, i, 0], buf[b, i, 1]
     return bx, by
 
 

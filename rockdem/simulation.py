@@ -109,6 +109,8 @@ def simulate(
     rec = new_records(frames, model.block_count, int(np.count_nonzero(~m.block_free.astype(bool))))
     frame = 0
     status = STATUS_DONE
+    sunk: str | None = None
+    thickness = _block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
     bar = None
     interrupted = False
@@ -123,6 +125,9 @@ def simulate(
                 state, scratch = grow_buffers(state, scratch)
                 continue
             if status != STATUS_DONE:
+                break
+            sunk = _sunk(model, state, thickness)
+            if sunk is not None:
                 break
             snaps.take(state)
             chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
@@ -154,9 +159,50 @@ def simulate(
         attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
         warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
         frame -= 1  # keep the sound frames before the bad one
+    elif sunk is not None:
+        t_now = float(state.time[0])
+        msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {sunk}; the result holds the frames computed"
+        attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
+                      "diverged_blocks": sunk.split("'")[1], "diverged_reason": "sank", "diverged_message": msg})
+        warnings.warn(msg, RuntimeWarning, stacklevel=2)
     rec = Records(*(a[:frame] for a in rec))
     ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
     return snaps.attach(ds)
+
+
+SINK_FRACTION = 0.25
+"""A run stops when a sub-contact's overlap exceeds this fraction of the thinner of its two blocks:
+the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
+
+
+def _block_thickness(model: Model) -> np.ndarray:
+    """(nb,) smallest extent of each block along its principal axes [m]."""
+    m = model.arrays
+    v, start = m.vertex_local, m.block_vertex_start
+    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
+
+
+def _sunk(model: Model, state: Any, thickness: np.ndarray) -> str | None:
+    """A description of the deepest sub-contact overlap if it exceeds SINK_FRACTION of the thinner
+    block, else None."""
+    m = model.arrays
+    partner = state.slot_partner
+    live = (partner >= 0) & (state.slot_area > 0.0)
+    if not live.any():
+        return None
+    pts, slot = np.nonzero(live)
+    owner, other = m.point_block[pts], partner[pts, slot]
+    depth = state.slot_overlap[pts, slot]
+    limit = SINK_FRACTION * np.minimum(thickness[owner], thickness[other])
+    k = int(np.argmax(depth / limit))
+    if not depth[k] > limit[k]:
+        return None
+    a, b = model.block_names[owner[k]], model.block_names[other[k]]
+    return (
+        f"block {a!r} sank {depth[k]:.3g} m into {b!r}, more than {SINK_FRACTION:.0%} of the thinner block: the joint "
+        f"stiffness kn = {m.mat_kn[m.block_group[owner[k]], m.block_group[other[k]]]:.3g} Pa/m is far too low for the load "
+        "(kn = E / l with E in Pa, not MPa)"
+    )
 
 
 def _positive_number(name: str, value: Any, unit: str) -> float:
@@ -174,7 +220,7 @@ def _check_step_count(info: TimestepInfo, duration: float, max_steps: int) -> No
         "(stiffness kn in Pa/m or E in Pa, density in kg/m^3, beta in s)"
     )
     if not (math.isfinite(info.dt) and info.dt > 0):
-        raise ValueError(f"the stable timestep of this model is {info.dt!r} s: the run cannot proceed {where}")
+        raise ValueError(f"the stable timestep of this model is {info.dt!r} s: the run would need infinitely many steps {where}")
     if info.dt > duration:
         raise ValueError(
             f"the timestep {info.dt:.3g} s is longer than the run ({duration:.3g} s): the contacts are implausibly "

@@ -1,0 +1,509 @@
+"""Contact forces: the sub-contacts of face pairs and the point contacts of edge pairs (paper §3).
+
+Each contact's force (spring, dashpot and transition corrections, :mod:`rockdem.kernels.contact`)
+is stored with its point of application, per sub-contact in ``sc.contact_force`` /
+``sc.contact_point`` and per edge pair in ``sc.pair_force`` / ``sc.pair_point``, and then added to
+the blocks by :func:`accumulate` in the fixed pair order (so results do not depend on how the
+contacts were computed).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .contact import (
+    coulomb_limit,
+    drop_dissipation,
+    ramp_overlap,
+    release_shear,
+    shear_increment,
+    slip_dissipation,
+    spring_energy,
+)
+from .faces import COVER_FULL, COVER_NONE, COVER_PART, covered, face_map_arrays, partly_covered
+from .layout import (
+    E_BOND,
+    E_FRICTION,
+    FAILED_SHEAR,
+    FAILED_TENSION,
+    PAIR_EDGE,
+    SLOTS,
+    ModelArrays,
+    Scratch,
+    State,
+)
+from .polygon import segment_closest
+from .series import interpolate
+
+
+@njit(cache=True, inline="always")
+def _relative_velocity_arrays(
+    position: np.ndarray, velocity: np.ndarray, omega_world: np.ndarray, o: int, t: int, c0: float, c1: float, c2: float
+) -> tuple[float, float, float]:
+    r0, r1, r2 = c0 - position[o, 0], c1 - position[o, 1], c2 - position[o, 2]
+    q0, q1, q2 = c0 - position[t, 0], c1 - position[t, 1], c2 - position[t, 2]
+    v0 = velocity[o, 0] + omega_world[o, 1] * r2 - omega_world[o, 2] * r1 - (velocity[t, 0] + omega_world[t, 1] * q2 - omega_world[t, 2] * q1)
+    v1 = velocity[o, 1] + omega_world[o, 2] * r0 - omega_world[o, 0] * r2 - (velocity[t, 1] + omega_world[t, 2] * q0 - omega_world[t, 0] * q2)
+    v2 = velocity[o, 2] + omega_world[o, 0] * r1 - omega_world[o, 1] * r0 - (velocity[t, 2] + omega_world[t, 0] * q1 - omega_world[t, 1] * q0)
+    return v0, v1, v2
+
+
+@njit(cache=True, inline="always")
+def _store(force: np.ndarray, point: np.ndarray, k: int, f0: float, f1: float, f2: float, x0: float, x1: float, x2: float) -> None:
+    """Contact k's force (on its first block) and point of application."""
+    force[k, 0] = f0
+    force[k, 1] = f1
+    force[k, 2] = f2
+    point[k, 0] = x0
+    point[k, 1] = x1
+    point[k, 2] = x2
+
+
+@njit(cache=True, inline="always")
+def _apply(
+    position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
+    o: int, t: int, f0: float, f1: float, f2: float, c0: float, c1: float, c2: float,
+) -> None:
+    """Force f on block o and -f on block t, both at world point c; the reaction of driven blocks."""
+    r0, r1, r2 = c0 - position[o, 0], c1 - position[o, 1], c2 - position[o, 2]
+    q0, q1, q2 = c0 - position[t, 0], c1 - position[t, 1], c2 - position[t, 2]
+    force[o, 0] += f0
+    force[o, 1] += f1
+    force[o, 2] += f2
+    force[t, 0] -= f0
+    force[t, 1] -= f1
+    force[t, 2] -= f2
+    torque[o, 0] += r1 * f2 - r2 * f1
+    torque[o, 1] += r2 * f0 - r0 * f2
+    torque[o, 2] += r0 * f1 - r1 * f0
+    torque[t, 0] -= q1 * f2 - q2 * f1
+    torque[t, 1] -= q2 * f0 - q0 * f2
+    torque[t, 2] -= q0 * f1 - q1 * f0
+    if free[o] and not free[t]:
+        reaction[0] += f0
+        reaction[1] += f1
+        reaction[2] += f2
+    elif free[t] and not free[o]:
+        reaction[0] -= f0
+        reaction[1] -= f1
+        reaction[2] -= f2
+
+
+@njit(cache=True)
+def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
+    """Add every stored contact force to its two blocks (and to the reaction of driven blocks)."""
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            f = sc.pair_force[i]
+            c = sc.pair_point[i]
+            _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, s.pair_a[i], s.pair_b[i], f[0], f[1], f[2], c[0], c[1], c[2])
+            continue
+        o = m.face_block[s.pair_owner_face[i]]
+        t = m.face_block[s.pair_target_face[i]]
+        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            f0 = sc.contact_force[k, 0]
+            f1 = sc.contact_force[k, 1]
+            f2 = sc.contact_force[k, 2]
+            if f0 != 0.0 or f1 != 0.0 or f2 != 0.0:
+                _apply(
+                    s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f0, f1, f2,
+                    sc.contact_point[k, 0], sc.contact_point[k, 1], sc.contact_point[k, 2],
+                )
+
+
+@njit(cache=True)
+def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
+    """Effective area and force point (``sc.track_cover``) of every sub-contact whose cell its target
+    face wholly covers (zero area for faces at right angles); the others are listed in
+    ``sc.pending`` for :func:`_partial_pass`. Returns how many are listed."""
+    npend = 0
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            continue
+        fo = s.pair_owner_face[i]
+        ft = s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        flat = abs(fm.det) < 1e-9
+        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            p = s.track[k] // SLOTS
+            state = COVER_NONE if flat else covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, 0.0)
+            if state != COVER_PART:
+                sc.track_cover[k, 0] = m.point_area[p] if state == COVER_FULL else 0.0
+                sc.track_cover[k, 1] = m.point_node[p, 0]
+                sc.track_cover[k, 2] = m.point_node[p, 1]
+            else:
+                sc.pending[npend] = k
+                sc.pending_pair[npend] = i
+                npend += 1
+    return npend
+
+
+@njit(cache=True)
+def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
+    """Clip the cells of the sub-contacts listed by :func:`_cover_pass` (:func:`faces.partly_covered`)."""
+    for q in range(npend):
+        k = sc.pending[q]
+        i = sc.pending_pair[q]
+        fo = s.pair_owner_face[i]
+        ft = s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        p = s.track[k] // SLOTS
+        area, yu, yw = partly_covered(
+            m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
+            m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0,
+        )
+        sc.track_cover[k, 0] = area
+        sc.track_cover[k, 1] = yu
+        sc.track_cover[k, 2] = yw
+
+
+@njit(cache=True)
+def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
+    """The joint law of every sub-contact of the face pairs, their covers known: stores its force
+    and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
+    that opened during the last step in ``sc.pending`` for :func:`_release_pass`.
+
+    Returns (elastic energy, active count, friction and bond energy dissipated, opened count).
+    Performance note: this loop calls only small inlined functions and makes no array views. A
+    call to a compiled function, or an inlined one with loops of its own (a clipping, a
+    quadrature), anywhere in it stops Numba from pruning the reference counting of every array it
+    touches, which made it ten times slower: such rare work is done in the other passes.
+    """
+    elastic = 0.0
+    active = 0
+    e_fric = 0.0
+    e_bond = 0.0
+    nrel = 0
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            continue
+        fo = s.pair_owner_face[i]
+        ft = s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        o = m.face_block[fo]
+        t = m.face_block[ft]
+        go = m.block_group[o]
+        gt = m.block_group[t]
+        kn = m.mat_kn[go, gt]
+        ks = m.mat_ks[go, gt]
+        beta = m.mat_beta[go, gt]
+        n0, n1, n2 = fm.nx, fm.ny, fm.nz
+        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            code = s.track[k]
+            p = code // SLOTS
+            j = code - SLOTS * p
+            sc.dashpot_force[k, 0] = 0.0
+            sc.dashpot_force[k, 1] = 0.0
+            sc.dashpot_force[k, 2] = 0.0
+            sc.contact_force[k, 0] = 0.0
+            sc.contact_force[k, 1] = 0.0
+            sc.contact_force[k, 2] = 0.0
+            area = sc.track_cover[k, 0]
+            yu = sc.track_cover[k, 1]
+            yw = sc.track_cover[k, 2]
+            un = -(fm.h0 + fm.hu * yu + fm.hw * yw)
+            un_prev = s.slot_overlap[p, j]
+            s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
+            us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
+            bonded = s.slot_bonded[p, j]
+            prev_area = s.slot_area[p, j]
+            s.slot_area[p, j] = area
+            # Contact point: midway between the owner-plane point and the target plane.
+            x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
+            x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
+            x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
+            v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
+            vn = v0 * n0 + v1 * n1 + v2 * n2  # > 0: separating
+            vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+            kna = kn * area
+            ksa = ks * area
+            fn = kna * un
+            opened = area <= 0.0 or (un <= 0.0 and not bonded)
+            if not opened and bonded and fn < -m.mat_tension[go, gt] * area:
+                # Tension cut-off: the bond fails and the point opens.
+                e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+                s.slot_bonded[p, j] = False
+                s.point_failed[p] = FAILED_TENSION
+                opened = True
+                bonded = False
+                prev_area = 0.0  # its energy is counted
+            if opened:
+                # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
+                e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
+                if bonded:
+                    e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
+                    s.slot_bonded[p, j] = False
+                    s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
+                elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
+                    # Opened during the last step: its release is computed apart (release pass), its
+                    # shear extension kept until then.
+                    sc.pending[nrel] = k
+                    sc.pending_pair[nrel] = i
+                    sc.release_overlap[nrel] = un_prev
+                    sc.release_area[nrel] = prev_area
+                    nrel += 1
+                    s.slot_normal_force[p, j] = 0.0
+                    continue
+                else:
+                    e_fric += e
+                s.slot_shear[p, j, 0] = 0.0
+                s.slot_shear[p, j, 1] = 0.0
+                s.slot_shear[p, j, 2] = 0.0
+                s.slot_normal_force[p, j] = 0.0
+                continue
+            # An unbonded contact that closed during the last step: its springs act since the crossing
+            # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
+            ramp = 1.0
+            since = dt
+            if not bonded and un_prev <= 0.0 and vn < 0.0:
+                since = min(un / (-vn * dt), 1.0) * dt
+                ramp = ramp_overlap(un, un_prev, vn, dt) / un
+            f_applied = fn * ramp
+            us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
+            trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+            if bonded:
+                fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
+            else:
+                fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
+            slipping = trial > fmax
+            gone = False
+            if slipping:
+                e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
+                if bonded:
+                    # Shear failure: drop to the residual strength; the released energy is the bond's.
+                    s.slot_bonded[p, j] = False
+                    s.point_failed[p] = FAILED_SHEAR
+                    fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
+                    e_bond += drop_dissipation(fmax, fres, ksa)
+                    fmax = fres
+                    if un <= 0.0:  # held only by the bond: it opens
+                        e_bond += spring_energy(fn, kna) + spring_energy(fmax, ksa)
+                        gone = True
+                f = fmax / trial if trial > 0.0 else 0.0
+                us0 *= f
+                us1 *= f
+                us2 *= f
+            if gone:
+                us0 = us1 = us2 = fn = 0.0
+            s.slot_shear[p, j, 0] = us0
+            s.slot_shear[p, j, 1] = us1
+            s.slot_shear[p, j, 2] = us2
+            s.slot_normal_force[p, j] = fn
+            if gone:
+                continue
+            elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
+            active += 1
+            # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
+            # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
+            fdn = -beta * kna * vn
+            bs = 0.0 if slipping else beta * ksa
+            d0 = fdn * n0 - bs * vs0
+            d1 = fdn * n1 - bs * vs1
+            d2 = fdn * n2 - bs * vs2
+            sc.dashpot_force[k, 0] = d0
+            sc.dashpot_force[k, 1] = d1
+            sc.dashpot_force[k, 2] = d2
+            fs = ksa * ramp
+            _store(
+                sc.contact_force, sc.contact_point, k,
+                f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
+                x0, x1, x2,
+            )
+
+    return elastic, active, e_fric, e_bond, nrel
+
+
+@njit(cache=True)
+def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -> float:
+    """Sub-contacts that opened during the last step (listed by :func:`_law_pass`): complete the
+    impulses of the normal ramp and of the capped shear force up to the opening time
+    (:func:`contact.ramp_overlap`, :func:`contact.release_shear`); returns the friction energy."""
+    e_fric = 0.0
+    for q in range(nrel):
+        k = sc.pending[q]
+        i = sc.pending_pair[q]
+        un_prev = sc.release_overlap[q]
+        prev_area = sc.release_area[q]
+        fo = s.pair_owner_face[i]
+        ft = s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        o = m.face_block[fo]
+        t = m.face_block[ft]
+        go = m.block_group[o]
+        gt = m.block_group[t]
+        kn = m.mat_kn[go, gt]
+        ks = m.mat_ks[go, gt]
+        p = s.track[k] // SLOTS
+        j = s.track[k] - SLOTS * p
+        area = sc.track_cover[k, 0]
+        yu = sc.track_cover[k, 1]
+        yw = sc.track_cover[k, 2]
+        un = -(fm.h0 + fm.hu * yu + fm.hw * yw)
+        n0, n1, n2 = fm.nx, fm.ny, fm.nz
+        x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
+        x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
+        x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
+        v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
+        vn = v0 * n0 + v1 * n1 + v2 * n2
+        fnc = kn * area * ramp_overlap(un, un_prev, vn, dt)
+        c0, c1, c2, d = release_shear(
+            s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2], ks * prev_area,
+            m.mat_res_tan_friction[go, gt] * kn * prev_area, un_prev, vn, v0 - vn * n0, v1 - vn * n1, v2 - vn * n2, dt,
+        )
+        e_fric += d
+        _store(sc.contact_force, sc.contact_point, k, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
+        s.slot_shear[p, j, 0] = 0.0
+        s.slot_shear[p, j, 1] = 0.0
+        s.slot_shear[p, j, 2] = 0.0
+    return e_fric
+
+
+@njit(cache=True, inline="always")
+def _world_point(m: ModelArrays, s: State, sc: Scratch, b: int, v: int) -> tuple[float, float, float]:
+    r = sc.rotation[b]
+    x = m.vertex_local[v]
+    return (
+        r[0, 0] * x[0] + r[0, 1] * x[1] + r[0, 2] * x[2] + s.position[b, 0],
+        r[1, 0] * x[0] + r[1, 1] * x[1] + r[1, 2] * x[2] + s.position[b, 1],
+        r[2, 0] * x[0] + r[2, 1] * x[1] + r[2, 2] * x[2] + s.position[b, 2],
+    )
+
+
+EDGE_PARALLEL_SIN = 0.05
+"""Below this sine of the angle between two edges their cross product no longer defines the
+contact normal: the last normal is kept."""
+
+
+@njit(cache=True)
+def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tuple[float, int, float]:
+    """Force of the point contact of EDGE pair i (edge of block a on edge of block b); returns
+    (elastic energy, active count, friction energy dissipated).
+
+    Stiffness: kn A_e and ks A_e with A_e the smaller of the two edges' ``edge_area`` (the mean
+    tributary area of the interface points of the faces meeting at the edge): an edge-edge contact
+    is as stiff as one interface point of the coarser-discretised side would be.
+    """
+    a = s.pair_a[i]
+    b = s.pair_b[i]
+    ea = s.pair_edge_a[i]
+    eb = s.pair_edge_b[i]
+    sc.pair_dashpot_force[i, :] = 0.0
+    sc.pair_force[i, :] = 0.0
+    a00, a01, a02 = _world_point(m, s, sc, a, m.edge_vertex[ea, 0])
+    a10, a11, a12 = _world_point(m, s, sc, a, m.edge_vertex[ea, 1])
+    b00, b01, b02 = _world_point(m, s, sc, b, m.edge_vertex[eb, 0])
+    b10, b11, b12 = _world_point(m, s, sc, b, m.edge_vertex[eb, 1])
+    da0, da1, da2 = a10 - a00, a11 - a01, a12 - a02
+    db0, db1, db2 = b10 - b00, b11 - b01, b12 - b02
+    sa, sb = segment_closest(a00, a01, a02, da0, da1, da2, b00, b01, b02, db0, db1, db2)
+    qa0, qa1, qa2 = a00 + sa * da0, a01 + sa * da1, a02 + sa * da2
+    qb0, qb1, qb2 = b00 + sb * db0, b01 + sb * db1, b02 + sb * db2
+    c0, c1, c2 = da1 * db2 - da2 * db1, da2 * db0 - da0 * db2, da0 * db1 - da1 * db0
+    cn = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    la = math.sqrt(da0 * da0 + da1 * da1 + da2 * da2)
+    lb = math.sqrt(db0 * db0 + db1 * db1 + db2 * db2)
+    m0, m1, m2 = s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2]
+    if cn > EDGE_PARALLEL_SIN * la * lb:
+        n0, n1, n2 = c0 / cn, c1 / cn, c2 / cn
+        if n0 * m0 + n1 * m1 + n2 * m2 < 0.0:
+            n0, n1, n2 = -n0, -n1, -n2
+    else:
+        n0, n1, n2 = m0, m1, m2
+    s.pair_normal[i, 0] = n0
+    s.pair_normal[i, 1] = n1
+    s.pair_normal[i, 2] = n2
+    un = -(n0 * (qa0 - qb0) + n1 * (qa1 - qb1) + n2 * (qa2 - qb2))
+    ga = m.block_group[a]
+    gb = m.block_group[b]
+    area = min(m.edge_area[ea], m.edge_area[eb])
+    kna = m.mat_kn[ga, gb] * area
+    ksa = m.mat_ks[ga, gb] * area
+    us0, us1, us2 = s.pair_shear[i, 0], s.pair_shear[i, 1], s.pair_shear[i, 2]
+    un_prev = s.pair_overlap[i]
+    s.pair_overlap[i] = un
+    x0, x1, x2 = 0.5 * (qa0 + qb0), 0.5 * (qa1 + qb1), 0.5 * (qa2 + qb2)
+    v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, a, b, x0, x1, x2)
+    vn = v0 * n0 + v1 * n1 + v2 * n2
+    vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+    if un <= 0.0:
+        e = 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+        if un_prev > 0.0:
+            fnc = kna * ramp_overlap(un, un_prev, vn, dt)
+            c0, c1, c2, e = release_shear(us0, us1, us2, ksa, m.mat_res_tan_friction[ga, gb] * kna, un_prev, vn, vs0, vs1, vs2, dt)
+            _store(sc.pair_force, sc.pair_point, i, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
+        s.pair_shear[i, 0] = 0.0
+        s.pair_shear[i, 1] = 0.0
+        s.pair_shear[i, 2] = 0.0
+        s.pair_normal_force[i] = 0.0
+        return 0.0, 0, e
+    ramp = 1.0
+    since = dt
+    if un_prev <= 0.0 and vn < 0.0:
+        since = min(un / (-vn * dt), 1.0) * dt
+        ramp = ramp_overlap(un, un_prev, vn, dt) / un
+    fn = kna * un
+    f_applied = fn * ramp
+    us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
+    trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+    fmax = coulomb_limit(m.mat_res_cohesion[ga, gb], m.mat_res_tan_friction[ga, gb], area, fn)
+    e_fric = 0.0
+    slipping = trial > fmax
+    if slipping:
+        e_fric = slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
+        f = fmax / trial
+        us0 *= f
+        us1 *= f
+        us2 *= f
+    s.pair_shear[i, 0] = us0
+    s.pair_shear[i, 1] = us1
+    s.pair_shear[i, 2] = us2
+    s.pair_normal_force[i] = fn
+    beta = m.mat_beta[ga, gb]
+    fdn = -beta * kna * vn
+    bs = 0.0 if slipping else beta * ksa
+    d0, d1, d2 = fdn * n0 - bs * vs0, fdn * n1 - bs * vs1, fdn * n2 - bs * vs2
+    sc.pair_dashpot_force[i, 0] = d0
+    sc.pair_dashpot_force[i, 1] = d1
+    sc.pair_dashpot_force[i, 2] = d2
+    fs = ksa * ramp
+    _store(sc.pair_force, sc.pair_point, i, f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2, x0, x1, x2)
+    return spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa), 1, e_fric
+
+
+@njit(cache=True)
+def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
+    """Forces and torques on every block at the current poses (DESIGN: engine, joint law of paper §3)."""
+    nb = m.block_mass.shape[0]
+    sc.force[:] = 0.0
+    sc.torque[:] = 0.0
+    sc.reaction[:] = 0.0
+    interpolate(m.body_time, m.body_acceleration, 0, m.body_time.shape[0], t, sc.body_acc)
+    for b in range(nb):
+        r = sc.rotation[b]
+        for i in range(3):
+            sc.omega_world[b, i] = r[i, 0] * s.omega[b, 0] + r[i, 1] * s.omega[b, 1] + r[i, 2] * s.omega[b, 2]
+        if m.block_free[b]:
+            for i in range(3):
+                sc.force[b, i] = m.block_mass[b] * (m.gravity[i] + sc.body_acc[i])
+    npend = _cover_pass(m, s, sc)
+    if npend > 0:
+        _partial_pass(m, s, sc, npend)
+    elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt)
+    if nrel > 0:
+        e_fric += _release_pass(m, s, sc, nrel, dt)
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            el, ac, ef = _edge_pair(m, s, sc, i, dt)
+            elastic += el
+            active += ac
+            e_fric += ef
+    accumulate(m, s, sc)
+    sc.elastic_energy[0] = elastic
+    sc.active_count[0] = active
+    s.energy[E_FRICTION] += e_fric
+    s.energy[E_BOND] += e_bond
+
+
