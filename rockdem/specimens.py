@@ -28,6 +28,7 @@ from .model import GROUND, Motion, ModelBuilder
 from .simulation import Monitor
 
 __all__ = [
+    "collapse_extent",
     "stacked_blocks",
     "brick_wall",
     "parapet",
@@ -89,13 +90,22 @@ def _set_pairs(builder: ModelBuilder, pairs: Sequence[tuple[str, str]], material
         builder.set_material(a, b, material)
 
 
+def collapse_extent(width: float, length: float, height: float) -> float:
+    """Plan size [m] of a square foundation on which a specimen of plan ``width`` x ``length`` and
+    ``height`` [m] (centred on the origin) lands whole when it topples in any direction: its plan
+    half-size plus its height, plus half its height again for the parts that slide, tumble or
+    bounce on, doubled: max(width, length) + 3 height."""
+    return max(width, length) + 3.0 * height
+
+
 def add_foundation(builder: ModelBuilder, extent: float, *, name: str = "foundation") -> int:
     """Add a driven ``"ground"`` box (group ``"foundation"``) whose top face is z = 0.
 
     Args:
         builder: the model builder.
         extent: plan size of the square box [m] (its depth is a quarter of it); it is centred on
-            the origin, so give at least twice the specimen's largest plan dimension.
+            the origin. For collapse give at least :func:`collapse_extent` of the specimen
+            (the specimen builders do), else toppled parts land on its edge or fall off.
         name: block name.
 
     Returns:
@@ -160,11 +170,14 @@ def stacked_blocks(
     material: JointMaterial | None = None,
     points: tuple[int, int] | None = None,
     foundation: bool = True,
+    foundation_extent: float | None = None,
 ) -> Monitors:
     """Blocks stacked with coinciding corners on a ground-driven foundation (paper §2.2).
 
     Args:
         builder: the model builder.
+        foundation_extent: plan size of the foundation [m]; default :func:`collapse_extent` of the
+            specimen, room for it to topple in any direction and land on the foundation.
         width: block width along x, the rocking direction [m].
         length: block length along y [m].
         heights: block heights from the bottom up [m]; blocks are named ``block1`` (bottom) to
@@ -188,7 +201,7 @@ def stacked_blocks(
     _positive("density", density, "kg/m^3")
     material = _material("material", material)
     if foundation:
-        add_foundation(builder, 2.0 * max(w, ln, sum(hs)))
+        add_foundation(builder, collapse_extent(w, ln, sum(hs)) if foundation_extent is None else foundation_extent)
     _set_pairs(builder, [("block", "block"), ("block", "foundation"), ("foundation", "foundation")], material)
     monitors: Monitors = {}
     z = 0.0
@@ -219,6 +232,7 @@ def brick_wall(
     points: tuple[int, int] = (2, 3),
     base_reduction: float = 0.0,
     foundation: bool = True,
+    foundation_extent: float | None = None,
 ) -> Monitors:
     """A wall discretised brick by brick (paper §3.2, Fig. 10C, 12A), standing on the foundation.
 
@@ -238,6 +252,8 @@ def brick_wall(
 
     Args:
         builder: the model builder.
+        foundation_extent: plan size of the foundation [m]; default :func:`collapse_extent` of the
+            specimen, room for it to topple in any direction and land on the foundation.
         brick: (lx thickness along x, ly length along the wall y, lz height z) [m], mortar included.
         courses: number of courses (>= 1).
         bricks_per_course: full bricks per unshifted course (>= 1).
@@ -289,7 +305,7 @@ def brick_wall(
     width = nb * ly
     height = nc * lz
     if foundation:
-        add_foundation(builder, 2.0 * max(lx, width, height))
+        add_foundation(builder, collapse_extent(lx, width, height) if foundation_extent is None else foundation_extent)
     _set_pairs(builder, [("brick", "brick")], joint)
     _set_pairs(builder, [("brick", "foundation"), ("foundation", "foundation")], base if base is not None else joint)
     pts = (int(points[0]), int(points[1]))
@@ -331,6 +347,7 @@ def parapet(
     material: JointMaterial | None = None,
     base_material: JointMaterial | None = None,
     points: tuple[int, int] | None = None,
+    foundation_extent: float | None = None,
 ) -> Monitors:
     """A free-standing URM parapet (Giaretton et al., paper §4.1) as one block or brick by brick.
 
@@ -342,6 +359,8 @@ def parapet(
 
     Args:
         builder: the model builder.
+        foundation_extent: plan size of the foundation [m]; default :func:`collapse_extent` of the
+            specimen, room for it to topple in any direction and land on the foundation.
         thickness: out-of-plane thickness along x [m].
         height: [m].
         length: along y [m].
@@ -393,7 +412,7 @@ def parapet(
             points=points or (2, 3),
             base_reduction=red,
         )
-    add_foundation(builder, 2.0 * max(t, ln, h))
+    add_foundation(builder, collapse_extent(t, ln, h) if foundation_extent is None else foundation_extent)
     _set_pairs(builder, [("block", "block"), ("foundation", "foundation")], material)
     _set_pairs(builder, [("block", "foundation")], material if base_material is None else base_material)
     poly = rounded_prism(t, ln, h, chamfer=0.5 * red, name="parapet") if red > 0 else box(t, ln, h, center=(0, 0, 0.5 * h), name="parapet")
@@ -420,6 +439,7 @@ def facade(
     return_material: JointMaterial | None = None,
     points: tuple[int, int] | None = None,
     rocking_velocity: float = 0.0,
+    foundation_extent: float | None = None,
 ) -> Monitors:
     """A façade rocking one-sidedly against return walls (Sorrentino et al., Shawa et al.; paper §4.2).
 
@@ -433,6 +453,8 @@ def facade(
 
     Args:
         builder: the model builder.
+        foundation_extent: plan size of the foundation [m]; default :func:`collapse_extent` of the
+            specimen, room for it to topple in any direction and land on the foundation.
         width: B, out-of-plane thickness (x) [m]. height: H [m]. length: L, along y [m].
         density: [kg/m^3].
         return_thickness: thickness t_r of each return wall (along y) [m], at most L/2.
@@ -486,7 +508,7 @@ def facade(
             f"slope_deg = {slope_deg} leans the façade into the return walls (top moves "
             f"{inner_top[0] - 0.5 * b:.4g} m inward, gap {g} m); use a smaller inward slope or a larger gap"
         )
-    fid = add_foundation(builder, 2.0 * max(b + g + lr, ln, h))
+    fid = add_foundation(builder, collapse_extent(b + g + lr, ln, h) if foundation_extent is None else foundation_extent)
     groups = [("facade", "foundation"), ("facade", "facade"), ("foundation", "foundation"), ("return", "return"), ("return", "foundation")]
     _set_pairs(builder, groups, material)
     _set_pairs(builder, [("facade", "return")], return_material if return_material is not None else material)
@@ -564,6 +586,7 @@ def two_block_wall(
     hold_time: float = 0.1,
     withdraw_speed: float = 1.0,
     points: tuple[int, int] | None = None,
+    foundation_extent: float | None = None,
 ) -> Monitors:
     """A pre-cracked vertically spanning wall of two blocks (Griffith et al.; paper §4.4, Fig. 17).
 
@@ -577,6 +600,8 @@ def two_block_wall(
 
     Args:
         builder: the model builder.
+        foundation_extent: plan size of the foundation [m]; default :func:`collapse_extent` of the
+            specimen, room for it to topple in any direction and land on the foundation.
         thickness: t along x [m]. height: H [m]. length: L along y [m].
         density: [kg/m^3].
         crack_height: height of the crack [m]; default H/2.
@@ -616,7 +641,7 @@ def two_block_wall(
         raise ValueError(f"push_displacement ({d0} m) must be below the thickness ({t} m) or the wall overturns")
     if d0 > 0 and not (0.5 * s < hc and hc + 0.5 * s < zr - 0.5 * s):
         raise ValueError(f"rod_size ({s} m) is too large for a pushing rod at the crack ({hc} m)")
-    add_foundation(builder, 2.0 * max(t, ln, h))
+    add_foundation(builder, collapse_extent(t, ln, h) if foundation_extent is None else foundation_extent)
     _set_pairs(builder, [("wall", "wall"), ("wall", "foundation"), ("foundation", "foundation")], material)
     if rod_material is None:
         base = material if material is not None else builder.default_material

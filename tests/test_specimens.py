@@ -297,3 +297,20 @@ def test_parapet_has_a_separate_base_joint():
         assert base.cohesion == 0.0 and base.tension == 0.0 and base.friction_angle == 30.0
         if brick:
             assert mats[("brick", "brick")].cohesion == 5e5
+
+
+def test_foundations_are_sized_for_collapse_or_take_an_extent():
+    # A four-drum column 2 m tall toppling whole from the origin reaches 0.2 + 2 m: its
+    # foundation must reach that far in every direction (issue 11: toppled parts fell off).
+    from rockdem.specimens import collapse_extent
+
+    mat = JointMaterial(kn=1e9, friction_angle=35)
+    for extent, expect in ((None, collapse_extent(0.4, 0.4, 2.0)), (7.5, 7.5)):
+        bld = ModelBuilder()
+        stacked_blocks(bld, width=0.4, length=0.4, heights=[0.5] * 4, material=mat, foundation_extent=extent)
+        model = bld.finalize()
+        f = model.block_id("foundation")
+        v = model.world_points(f, model.arrays.vertex_local[model.arrays.block_vertex_start[f] : model.arrays.block_vertex_start[f + 1]])
+        half = 0.5 * np.ptp(v[:, :2], axis=0)
+        np.testing.assert_allclose(half, 0.5 * expect, rtol=1e-9)
+        assert half.min() >= 0.2 + 2.0
