@@ -90,16 +90,20 @@ def test_unknown_top_level_table():
 
 def test_divergence_check_cuts_a_blown_up_run_and_passes_a_sound_one():
     # A sound run keeps its energy balance (error ~1e-3 of the energy scale): no divergence. A run
-    # whose balance breaks (here injected: 50 J appear from nothing at frame k) or whose state is no
-    # longer finite is cut at the first bad frame (the engine then warns and keeps the frames before).
+    # that creates energy (here injected: 50 J of kinetic energy appear from nothing at frame k) or
+    # whose state is no longer finite is cut at the first bad frame (the engine then warns and keeps
+    # the frames before). A dissipation booked in excess creates no energy: not a divergence.
     from rockdem.simulation import first_diverged_frame
 
     ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.3, record_interval=0.01)
     assert first_diverged_frame(ds) is None and "diverged" not in ds.attrs
     k = 17
     bad = ds.copy(deep=True)
-    bad["energy_balance_error"].values[k:] += 50.0
+    bad["energy_kinetic"].values[k:] += 50.0
     assert first_diverged_frame(bad) == k
+    lossy = ds.copy(deep=True)
+    lossy["energy_friction"].values[k:] += 50.0
+    assert first_diverged_frame(lossy) is None
     bad = ds.copy(deep=True)
     bad["block_position"].values[k + 3, 1, 0] = np.nan
     assert first_diverged_frame(bad) == k + 3
