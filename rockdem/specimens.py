@@ -411,6 +411,7 @@ def parapet(
             density=density,
             points=points or (2, 3),
             base_reduction=red,
+            foundation_extent=foundation_extent,
         )
     add_foundation(builder, collapse_extent(t, ln, h) if foundation_extent is None else foundation_extent)
     _set_pairs(builder, [("block", "block"), ("foundation", "foundation")], material)

@@ -314,3 +314,17 @@ def test_foundations_are_sized_for_collapse_or_take_an_extent():
         half = 0.5 * np.ptp(v[:, :2], axis=0)
         np.testing.assert_allclose(half, 0.5 * expect, rtol=1e-9)
         assert half.min() >= 0.2 + 2.0
+
+
+@pytest.mark.parametrize("brick", [None, (0.2, 0.25)])
+def test_parapet_foundation_extent_is_honoured_whole_or_brick_by_brick(brick):
+    from rockdem.specimens import collapse_extent
+
+    for extent, expect in ((None, collapse_extent(0.23, 1.2, 1.0)), (12.0, 12.0)):
+        bld = ModelBuilder()
+        parapet(bld, height=1.0, length=1.2, brick=brick, material=MORTAR, foundation_extent=extent)
+        model = bld.finalize()
+        f = model.block_id("foundation")
+        a = model.arrays
+        v = a.vertex_local[a.block_vertex_start[f] : a.block_vertex_start[f + 1]]
+        assert np.ptp(v, axis=0).max() == pytest.approx(expect, rel=1e-9)
