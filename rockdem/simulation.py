@@ -109,7 +109,7 @@ def simulate(
     rec = new_records(frames, model.block_count, int(np.count_nonzero(~m.block_free.astype(bool))))
     frame = 0
     status = STATUS_DONE
-    sunk: str | None = None
+    sunk: tuple[str, str] | None = None
     thickness = _block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
     bar = None
@@ -161,9 +161,10 @@ def simulate(
         frame -= 1  # keep the sound frames before the bad one
     elif sunk is not None:
         t_now = float(state.time[0])
-        msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {sunk}; the result holds the frames computed"
+        block, what = sunk
+        msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {what}; the result holds the frames computed"
         attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
-                      "diverged_blocks": sunk.split("'")[1], "diverged_reason": "sank", "diverged_message": msg})
+                      "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
     rec = Records(*(a[:frame] for a in rec))
     ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
@@ -182,9 +183,9 @@ def _block_thickness(model: Model) -> np.ndarray:
     return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
-def _sunk(model: Model, state: Any, thickness: np.ndarray) -> str | None:
-    """A description of the deepest sub-contact overlap if it exceeds SINK_FRACTION of the thinner
-    block, else None."""
+def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | None:
+    """(name of the sinking block, description) of the deepest sub-contact overlap if it exceeds
+    SINK_FRACTION of the thinner block, else None."""
     m = model.arrays
     partner = state.slot_partner
     live = (partner >= 0) & (state.slot_area > 0.0)
@@ -198,7 +199,7 @@ def _sunk(model: Model, state: Any, thickness: np.ndarray) -> str | None:
     if not depth[k] > limit[k]:
         return None
     a, b = model.block_names[owner[k]], model.block_names[other[k]]
-    return (
+    return a, (
         f"block {a!r} sank {depth[k]:.3g} m into {b!r}, more than {SINK_FRACTION:.0%} of the thinner block: the joint "
         f"stiffness kn = {m.mat_kn[m.block_group[owner[k]], m.block_group[other[k]]]:.3g} Pa/m is far too low for the load "
         "(kn = E / l with E in Pa, not MPa)"

@@ -6,8 +6,6 @@ Polygons are (n, 2) counter-clockwise vertex buffers with an explicit count; hal
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit
 
@@ -120,11 +118,3 @@ def segment_closest(
         s = min(max((b - c) / a, 0.0), 1.0)
     return s, t
 
-
-@njit(cache=True, inline="always")
-def normalize3(x: float, y: float, z: float) -> tuple[float, float, float, float]:
-    """Unit vector and the length of (x, y, z)."""
-    n = math.sqrt(x * x + y * y + z * z)
-    if n == 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    return x / n, y / n, z / n, n
