@@ -584,7 +584,7 @@ class ModelBuilder:
             body_acceleration=ba,
             contact_tol=float(contact_tolerance),
             touch_tol=0.1 * float(contact_tolerance),
-            **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0),
+            **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0, free_mask),
         )
         return Model(
             arrays=arrays,
@@ -617,17 +617,27 @@ MAX_MOTION_SAMPLES = 10_000_000
 """Most samples of a prescribed motion built by :meth:`Motion.from_function`."""
 
 
-def _extent(vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+def _extent(
+    vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64], free: NDArray[np.bool_]
+) -> dict[str, NDArray[np.float64]]:
     """The model's extent: the bounding box of every block at the start, enlarged on each side by
-    its largest dimension (at least 1 m). A free block whose centroid leaves it has fallen through
-    its support or flown away, and the run stops there."""
+    its largest dimension (at least 1 m); and the plan footprint (x, y) of the driven blocks at the
+    start (empty when there are none). A free block whose centroid leaves the extent through its
+    bottom outside that footprint fell off the edge of the supports and falls on unhindered; one
+    leaving it otherwise has fallen through its support or flown away, and the run stops there."""
     from .kernels.rotation import quats_to_matrices
 
     r = quats_to_matrices(quat)
     world = np.vstack([vertex_local[vstart[b] : vstart[b + 1]] @ r[b].T + pos[b] for b in range(len(pos))])
     lo, hi = world.min(axis=0), world.max(axis=0)
     margin = max(float(np.max(hi - lo)), 1.0)
-    return {"extent_low": lo - margin, "extent_high": hi + margin}
+    driven = [b for b in range(len(pos)) if not free[b]]
+    if driven:
+        support = np.vstack([world[vstart[b] : vstart[b + 1]] for b in driven])
+        s_lo, s_hi = support[:, :2].min(axis=0), support[:, :2].max(axis=0)
+    else:
+        s_lo, s_hi = np.full(2, np.inf), np.full(2, -np.inf)
+    return {"extent_low": lo - margin, "extent_high": hi + margin, "support_low": s_lo, "support_high": s_hi}
 
 
 def _check_points(points: Sequence[int], what: str) -> tuple[int, int]:

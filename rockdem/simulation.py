@@ -166,6 +166,16 @@ def simulate(
         attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                       "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
+    fell = np.flatnonzero(state.fell_off >= 0.0)
+    if fell.size:
+        listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
+        attrs["fell_off_blocks"] = ", ".join(model.block_names[b] for b in fell)
+        attrs["fell_off_times"] = state.fell_off[fell].astype(float)
+        warnings.warn(
+            f"block(s) fell off the edge of the model's supports and fall on unhindered: {listed}; "
+            "a larger foundation (the specimen builders' foundation_extent) keeps them",
+            RuntimeWarning, stacklevel=2,
+        )
     rec = Records(*(a[:frame] for a in rec))
     ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
     return snaps.attach(ds)

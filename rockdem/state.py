@@ -95,6 +95,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         track_count=np.zeros(1, dtype=np.int64),
         pair_count=np.zeros(1, dtype=np.int64),
         moved=np.zeros(nb),
+        fell_off=np.full(nb, -1.0),
         **_pair_arrays(pairs),
     )
     sc = Scratch(

@@ -277,3 +277,35 @@ def test_a_block_sinking_into_far_too_soft_joints_stops_the_run():
     assert float(ds.time[-1]) < 3.0
     sink = -float(ds.block_position.values[-1, 1, 2] - 0.5)
     assert sink > SINK_FRACTION * 0.2 * 0.5  # it had sunk well into the ground when it stopped
+
+
+def test_a_block_falling_off_the_edge_of_its_foundation_falls_on_and_the_run_completes():
+    # A tall block tilted past its slenderness angle near the edge of a small foundation topples
+    # over the edge. The run goes on to its end (it is not a divergence), names the block and the
+    # time it left, and the block falls freely: g t^2 / 2 below the foundation, energy conserved.
+    from rockdem.simulation import simulate
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1e9, friction_angle=35)
+    b.add_box(1.0, 1.0, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.2, 0.2, 1.0, base_center=(0.35, 0, 0), density=2000, name="block")
+    b.add_box(0.2, 0.2, 0.2, base_center=(-0.3, 0, 0), density=2000, name="stays")
+    b.tilt("block", 1.3)  # past its slenderness 0.2 / 1 -> topples towards +x
+    with pytest.warns(RuntimeWarning, match="fell off the edge"):
+        ds = simulate(b.finalize(damping=Damping(beta=1e-4)), 3.0, progress=False)
+    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(3.0, abs=1e-3)  # the frame nearest the end
+    assert ds.attrs["fell_off_blocks"] == "block"
+    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+    assert 0.3 < t_off < 3.0
+    z = ds.block_position.sel(block=1).values[:, 2]
+    vz = ds.block_velocity.sel(block=1).values[:, 2]
+    late = ds.time.values > t_off
+    # free fall after it left: constant acceleration -g
+    acc = np.gradient(vz[late], ds.time.values[late])
+    assert np.allclose(acc[2:-2], -9.81, rtol=1e-3)
+    assert z[-1] < -2.0
+    # the small block stays where it was, resting on the foundation
+    assert abs(float(ds.block_position.sel(block=2).values[-1, 0]) + 0.3) < 1e-3
+    # no energy created: kinetic + potential + elastic never exceed the initial energy
+    mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
+    assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81

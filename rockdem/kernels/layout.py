@@ -130,6 +130,8 @@ class ModelArrays(NamedTuple):
     touch_tol: float  # [m] gap within which joints count as touching at the start (bonded)
     extent_low: np.ndarray  # (3,) [m] lower corner of the model's extent (a free block leaving it is lost)
     extent_high: np.ndarray  # (3,) [m] upper corner
+    support_low: np.ndarray  # (2,) [m] plan (x, y) footprint of the driven blocks at the start, lower corner
+    support_high: np.ndarray  # (2,) [m] upper corner (low > high: no driven blocks)
 
 
 class State(NamedTuple):
@@ -172,6 +174,7 @@ class State(NamedTuple):
     pair_normal_force: np.ndarray  # (P,) [N] EDGE: elastic normal force
     pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass
     moved: np.ndarray  # (nb,) [m] displacement bound since the last detection
+    fell_off: np.ndarray  # (nb,) [s] time a free block fell off the edge of the supports, -1: it did not
 
 
 class Scratch(NamedTuple):

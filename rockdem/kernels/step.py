@@ -237,9 +237,12 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     was created: the mechanical energy (kinetic + potential + elastic) exceeds its initial value
     plus the work done on the model by more than DIVERGENCE_ERROR of the energy scale reached so far
     (kinetic + elastic + |potential change| + dissipated + |work|, at least the work of lifting the
-    free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent; else
-    STATUS_DONE. ``sc.lost_block`` names the block (-1 for an energy divergence). (A dissipation
-    term booked in excess shows in the recorded balance error but is not a divergence.)"""
+    free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent (fell
+    through its support or flew away); else STATUS_DONE. ``sc.lost_block`` names the block (-1 for
+    an energy divergence). A block leaving the extent through its bottom outside the plan footprint
+    of the driven blocks fell off the edge of the supports: its time is noted in ``s.fell_off``
+    and it falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
+    recorded balance error but is not a divergence.)"""
     e = rec.energy[frame]
     e0 = rec.energy[0]
     scale = 0.0
@@ -256,16 +259,23 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     if not (math.isfinite(err) and err <= DIVERGENCE_ERROR * sc.energy_scale[0]):
         return STATUS_DIVERGED
     for b in range(m.block_mass.shape[0]):
-        if not m.block_free[b]:
+        if not m.block_free[b] or s.fell_off[b] >= 0.0:
             continue
+        outside = False
         for i in range(3):
             x = s.position[b, i]
             if not math.isfinite(x):
                 sc.lost_block[0] = b
                 return STATUS_DIVERGED
-            if x < m.extent_low[i] or x > m.extent_high[i]:
-                sc.lost_block[0] = b
-                return STATUS_LOST
+            outside = outside or x < m.extent_low[i] or x > m.extent_high[i]
+        if outside:
+            x, y, z = s.position[b, 0], s.position[b, 1], s.position[b, 2]
+            off_edge = not (m.support_low[0] <= x <= m.support_high[0] and m.support_low[1] <= y <= m.support_high[1])
+            if z < m.extent_low[2] and off_edge:
+                s.fell_off[b] = rec.time[frame]
+                continue
+            sc.lost_block[0] = b
+            return STATUS_LOST
     return STATUS_DONE
 
 
@@ -292,7 +302,8 @@ def advance(
         update_rotations(m, s, sc)
         moved = 0.0
         for b in range(m.block_mass.shape[0]):
-            moved = max(moved, s.moved[b])
+            if s.fell_off[b] < 0.0:  # blocks that fell off the edge meet nothing more
+                moved = max(moved, s.moved[b])
         if 2.0 * moved >= m.contact_tol:
             detect(m, s, sc)
             if sc.overflow[0] > 0:
