@@ -130,6 +130,9 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         prev_pair_count=np.zeros(1, dtype=np.int64),
         energy_scale=one.copy(),
         lost_block=np.full(1, -1, dtype=np.int64),
+        sweep_order=np.zeros(nb, dtype=np.int64),
+        bound_stiffness=np.zeros(nb),
+        bound_beta=np.zeros(nb),
         **_scratch_pairs(pairs),
         **_scratch_candidates(cands),
     )

@@ -23,7 +23,7 @@ from .contact import sp_critical_factor
 from .layout import PAIR_EDGE, SLOTS, ModelArrays, Scratch, State
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, r1: float, r2: float, d0: float, d1: float, d2: float) -> float:
     """1/m + sum_j (r x d)_j^2 / I_j in a block's principal frame (0 for driven blocks: inv_mass 0)."""
     if inv_mass == 0.0:
@@ -38,7 +38,7 @@ def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, 
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _add_contact(
     m: ModelArrays, s: State, sc: Scratch, row: np.ndarray, beta: np.ndarray, o: int, t: int,
     x0: float, x1: float, x2: float, n0: float, n1: float, n2: float, area: float,
@@ -74,7 +74,7 @@ def _add_contact(
     beta[t] = max(beta[t], bt)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, float]:
     """Critical timestep of the tracked contacts (safety 1).
 
@@ -82,8 +82,10 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, 
     +inf when no block has a contact.
     """
     nb = m.block_mass.shape[0]
-    row = np.zeros(nb)
-    beta = np.zeros(nb)
+    row = sc.bound_stiffness
+    beta = sc.bound_beta
+    row[:] = 0.0
+    beta[:] = 0.0
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             a, b = s.pair_a[i], s.pair_b[i]

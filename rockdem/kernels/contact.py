@@ -32,19 +32,19 @@ import math
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def normal_force(kn: float, area: float, overlap: float) -> float:
     """Elastic normal force kn A u_n [N] (compression positive)."""
     return kn * area * overlap
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def coulomb_limit(cohesion: float, tan_friction: float, area: float, fn: float) -> float:
     """Shear strength c A + max(F_n, 0) tan(phi) [N]."""
     return cohesion * area + max(fn, 0.0) * tan_friction
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def slip_dissipation(ks_area: float, lam: float, e0_du: float, e0_sq: float, du_sq: float) -> float:
     """Energy dissipated by a slip step [J]: ks A [(e0 + lam e_t) . du / 2 - (lam^2 |e_t|^2 - |e0|^2) / 2]
     with e_t = e0 + du the trial extension, given e0 . du, |e0|^2, |du|^2 [m^2] (see the module notes)."""
@@ -53,19 +53,19 @@ def slip_dissipation(ks_area: float, lam: float, e0_du: float, e0_sq: float, du_
     return 0.5 * ks_area * (e0_du + lam * et_du - lam * lam * et_sq + e0_sq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def drop_dissipation(f_from: float, f_to: float, ks_area: float) -> float:
     """Energy released when a standing spring's force drops from f_from to f_to [J]: (f_from^2 - f_to^2) / (2 ks A)."""
     return 0.5 * (f_from * f_from - f_to * f_to) / ks_area
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def spring_energy(force: float, stiffness: float) -> float:
     """Energy stored in a linear spring F^2 / (2 k) [J]."""
     return 0.5 * force * force / stiffness if stiffness > 0.0 else 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def ramp_overlap(un: float, un_prev: float, vn: float, dt: float) -> float:
     """Overlap [m] whose spring force equals the exact mean force of an unbonded contact over the
     velocity interval [t - dt/2, t + dt/2] when it opened or closed during the last position step.
@@ -96,7 +96,7 @@ RELEASE_INTERVALS = 8
 linear except where the Coulomb cap takes over)."""
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def release_shear(
     us0: float, us1: float, us2: float, ks_area: float, cap_slope: float, un_prev: float, vn: float,
     vs0: float, vs1: float, vs2: float, dt: float,
@@ -145,7 +145,7 @@ def release_shear(
     return imp0 / dt - f0, imp1 / dt - f1, imp2 / dt - f2, stored - work
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def sp_critical_factor(beta: float, omega_max: float) -> float:
     """Timestep reduction sqrt(1 + xi^2) - xi, xi = beta omega_max / 2 (Belytschko, SP damping),
     evaluated as 1 / (sqrt(1 + xi^2) + xi), free of cancellation and overflow for large xi."""
@@ -153,7 +153,7 @@ def sp_critical_factor(beta: float, omega_max: float) -> float:
     return 1.0 / (math.hypot(1.0, xi) + xi)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def shear_increment(
     e0: float, e1: float, e2: float, n0: float, n1: float, n2: float, vs0: float, vs1: float, vs2: float, dt: float
 ) -> tuple[float, float, float, float, float, float]:

@@ -40,6 +40,7 @@ from .layout import (
     State,
 )
 from .rotation import quat_to_matrix
+from .sort import sort_indices
 
 EDGE_AXIS_BIAS = 1e-3
 """An edge x edge axis must separate by more than the best face axis plus this fraction of the
@@ -52,14 +53,14 @@ the face), while crossing edges, whose face axes overlap far more than their edg
 edge-edge contacts. Without the margin a tilting edge flips between the two representations."""
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def update_rotations(m: ModelArrays, s: State, sc: Scratch) -> None:
     """Rotation matrices of every block from its quaternion."""
     for b in range(m.block_mass.shape[0]):
         quat_to_matrix(s.quaternion[b], sc.rotation[b])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
     nb = m.block_mass.shape[0]
     for b in range(nb):
@@ -83,7 +84,7 @@ def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
             sc.aabb[b, 3 + i] += m.contact_tol
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _extent(wv: np.ndarray, v0: int, v1: int, ax: float, ay: float, az: float) -> tuple[float, float]:
     lo = np.inf
     hi = -np.inf
@@ -94,7 +95,7 @@ def _extent(wv: np.ndarray, v0: int, v1: int, ax: float, ay: float, az: float) -
     return lo, hi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def separating_axes(
     m: ModelArrays, s: State, sc: Scratch, a: int, b: int
 ) -> tuple[float, int, int, int, int, int, float, float, float]:
@@ -156,7 +157,7 @@ def separating_axes(
     return best, kind, ref, rface, da, db, nx, ny, nz
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _supporting_edge(m: ModelArrays, sc: Scratch, blk: int, i: int, nx: float, ny: float, nz: float, lowest: bool) -> int:
     """The edge of ``blk`` parallel to its edge direction ``i`` furthest along -n (``lowest``) or +n."""
     r = sc.rotation[blk]
@@ -192,7 +193,7 @@ of the most opposed one: a block rocking on an edge between two of its faces doe
 the face carrying its sub-contacts back and forth (each switch re-represents a loaded contact)."""
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _previous_pair(m: ModelArrays, sc: Scratch, a: int, b: int) -> int:
     """Index of pair (a, b) at the previous detection, -1 if it was not a pair (binary search)."""
     key = a * m.block_mass.shape[0] + b
@@ -200,16 +201,16 @@ def _previous_pair(m: ModelArrays, sc: Scratch, a: int, b: int) -> int:
     hi = sc.prev_pair_count[0]
     while lo < hi:
         mid = (lo + hi) // 2
-        if sc.prev_pair_key[mid] < key:
+        if sc.prev_pair_key[sc.prev_pair_index[mid]] < key:
             lo = mid + 1
         else:
             hi = mid
-    if lo < sc.prev_pair_count[0] and sc.prev_pair_key[lo] == key:
+    if lo < sc.prev_pair_count[0] and sc.prev_pair_key[sc.prev_pair_index[lo]] == key:
         return sc.prev_pair_index[lo]
     return -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _facing(r: np.ndarray, fn: np.ndarray, nx: float, ny: float, nz: float) -> float:
     return (
         (r[0, 0] * fn[0] + r[0, 1] * fn[1] + r[0, 2] * fn[2]) * nx
@@ -218,7 +219,7 @@ def _facing(r: np.ndarray, fn: np.ndarray, nx: float, ny: float, nz: float) -> f
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _incident_face(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, previous: int) -> int:
     """Face of ``blk`` most opposed to the world direction n, or ``previous`` (a face of blk, or
     -1) while it stays within INCIDENT_HYSTERESIS of it."""
@@ -234,7 +235,7 @@ def _incident_face(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, 
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -> int:
     """Narrow phase of pair (a, b), a < b: adds a pair and its candidate sub-contacts; returns the
     new candidate count."""
@@ -269,7 +270,8 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         k = _previous_pair(m, sc, a, b)  # carry the history of the same edge contact
         if k >= 0 and sc.prev_pair_kind[k] == PAIR_EDGE and sc.prev_pair_edge_a[k] == ea and sc.prev_pair_edge_b[k] == eb:
             sc.prev_pair_kept[k] = True
-            s.pair_shear[i, :] = sc.prev_pair_shear[k]
+            for c in range(3):
+                s.pair_shear[i, c] = sc.prev_pair_shear[k, c]
             s.pair_normal_force[i] = sc.prev_pair_normal_force[k]
             s.pair_overlap[i] = sc.prev_pair_overlap[k]
         return ncand
@@ -313,7 +315,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
     return ncand
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
     """Forget slot k of point p: a bond torn off counts as a tension failure; the energy still
     stored in its springs is dissipated (bond energy for a bond, friction otherwise)."""
@@ -344,7 +346,7 @@ def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
     s.slot_overlap[p, k] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
     """Give each candidate a slot of its point (its old one for the same partner), release the
     slots not found again, and list the tracked sub-contacts pair by pair."""
@@ -405,7 +407,7 @@ def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
     s.track_count[0] = n
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
     """Rebuild the pairs and the tracked sub-contacts at the current poses (rotations current).
 
@@ -433,18 +435,15 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
             sc.prev_pair_normal[i, k] = s.pair_normal[i, k]
         sc.prev_pair_kept[i] = False
         sc.prev_pair_key[i] = s.pair_a[i] * nb + s.pair_b[i]
-    order = np.argsort(sc.prev_pair_key[:npair])
-    keys = sc.prev_pair_key[:npair].copy()
-    for i in range(npair):
-        sc.prev_pair_key[i] = keys[order[i]]
-        sc.prev_pair_index[i] = order[i]
+    sort_indices(sc.prev_pair_key, sc.prev_pair_index, npair)
     s.pair_count[0] = 0
     sc.min_separation[0] = np.inf
     sc.min_pair[0] = -1
     sc.min_pair[1] = -1
     sc.overflow[0] = 0
     ncand = 0
-    order = np.argsort(sc.aabb[:, 0], kind="mergesort")
+    order = sc.sweep_order
+    sort_indices(sc.aabb[:, 0], order, nb)
     for ii in range(nb):
         a = order[ii]
         for jj in range(ii + 1, nb):
@@ -468,7 +467,7 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
         s.moved[b] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _release_lost_edges(m: ModelArrays, s: State, sc: Scratch) -> None:
     """Edge contacts of the previous detection not found again: their stored spring energy is
     dissipated (friction)."""

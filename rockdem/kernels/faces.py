@@ -68,7 +68,7 @@ class FaceMap(NamedTuple):
     det: float
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _rot(r: np.ndarray, v: np.ndarray) -> tuple[float, float, float]:
     return (
         r[0, 0] * v[0] + r[0, 1] * v[1] + r[0, 2] * v[2],
@@ -77,13 +77,13 @@ def _rot(r: np.ndarray, v: np.ndarray) -> tuple[float, float, float]:
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def face_map(m: ModelArrays, s: State, sc: Scratch, fo: int, ft: int) -> FaceMap:
     """The map from owner face ``fo`` to target face ``ft`` at the current poses."""
     return face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def face_map_arrays(
     face_block: np.ndarray, face_origin: np.ndarray, face_u: np.ndarray, face_w: np.ndarray, face_normal: np.ndarray,
     rotation: np.ndarray, position: np.ndarray, fo: int, ft: int,
@@ -129,7 +129,7 @@ COVER_NONE = 0
 COVER_PART = -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray,
     p: int, ft: int, fm: FaceMap, grow: float,
@@ -180,7 +180,7 @@ def covered(
     return COVER_FULL if full else COVER_PART
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
@@ -237,7 +237,7 @@ def partly_covered(
     return area, yu, yw
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float) -> tuple[float, float, float]:
     """Effective area [m^2] of point p against target face ``ft`` (its cell clipped by the target
     polygon grown by ``grow`` [m]) and where its force acts, (u, w) in owner face coordinates.

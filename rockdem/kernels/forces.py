@@ -39,7 +39,7 @@ from .polygon import segment_closest
 from .series import interpolate
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _relative_velocity_arrays(
     position: np.ndarray, velocity: np.ndarray, omega_world: np.ndarray, o: int, t: int, c0: float, c1: float, c2: float
 ) -> tuple[float, float, float]:
@@ -51,7 +51,7 @@ def _relative_velocity_arrays(
     return v0, v1, v2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _store(force: np.ndarray, point: np.ndarray, k: int, f0: float, f1: float, f2: float, x0: float, x1: float, x2: float) -> None:
     """Contact k's force (on its first block) and point of application."""
     force[k, 0] = f0
@@ -62,7 +62,7 @@ def _store(force: np.ndarray, point: np.ndarray, k: int, f0: float, f1: float, f
     point[k, 2] = x2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _apply(
     position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
     o: int, t: int, f0: float, f1: float, f2: float, c0: float, c1: float, c2: float,
@@ -92,7 +92,7 @@ def _apply(
         reaction[2] -= f2
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
     """Add every stored contact force to its two blocks (and to the reaction of driven blocks)."""
     for i in range(s.pair_count[0]):
@@ -114,7 +114,7 @@ def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
                 )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
     """Effective area and force point (``sc.track_cover``) of every sub-contact whose cell its target
     face wholly covers (zero area for faces at right angles); the others are listed in
@@ -141,7 +141,7 @@ def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
     return npend
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
     """Clip the cells of the sub-contacts listed by :func:`_cover_pass` (:func:`faces.partly_covered`)."""
     for q in range(npend):
@@ -160,7 +160,7 @@ def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
         sc.track_cover[k, 2] = yw
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
     """The joint law of every sub-contact of the face pairs, their covers known: stores its force
     and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
@@ -316,7 +316,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
     return elastic, active, e_fric, e_bond, nrel
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -> float:
     """Sub-contacts that opened during the last step (listed by :func:`_law_pass`): complete the
     impulses of the normal ramp and of the capped shear force up to the opening time
@@ -361,7 +361,7 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
     return e_fric
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _world_point(m: ModelArrays, s: State, sc: Scratch, b: int, v: int) -> tuple[float, float, float]:
     r = sc.rotation[b]
     x = m.vertex_local[v]
@@ -377,7 +377,7 @@ EDGE_PARALLEL_SIN = 0.05
 contact normal: the last normal is kept."""
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tuple[float, int, float]:
     """Force of the point contact of EDGE pair i (edge of block a on edge of block b); returns
     (elastic energy, active count, friction energy dissipated).
@@ -473,7 +473,7 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     return spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa), 1, e_fric
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
     """Forces and torques on every block at the current poses (DESIGN: engine, joint law of paper §3)."""
     nb = m.block_mass.shape[0]

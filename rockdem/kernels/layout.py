@@ -228,11 +228,14 @@ class Scratch(NamedTuple):
     prev_pair_normal: np.ndarray  # (P, 3)
     prev_pair_normal_force: np.ndarray  # (P,)
     prev_pair_overlap: np.ndarray  # (P,)
-    prev_pair_key: np.ndarray  # (P,) int64 sorted keys a nb + b of the previous pairs
-    prev_pair_index: np.ndarray  # (P,) int64 the previous pair of each sorted key
+    prev_pair_key: np.ndarray  # (P,) int64 key a nb + b of each previous pair
+    prev_pair_index: np.ndarray  # (P,) int64 the previous pairs in ascending key order
     prev_pair_kept: np.ndarray  # (P,) bool the previous pair was found again
     energy_scale: np.ndarray  # (1,) [J] largest energy scale recorded so far (divergence check)
     lost_block: np.ndarray  # (1,) int64 block that diverged or left the extent, -1 none
+    sweep_order: np.ndarray  # (nb,) int64 detection: blocks in ascending order of their lowest x
+    bound_stiffness: np.ndarray  # (nb,) [1/s^2] contact_bound: each block's row-sum stiffness over its mass
+    bound_beta: np.ndarray  # (nb,) [s] contact_bound: the largest beta of its contacts
 
 
 class Records(NamedTuple):

@@ -10,7 +10,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def clip_halfplane(buf: np.ndarray, i: int, n: int, lu: float, lw: float, lo: float) -> int:
     """Sutherland-Hodgman step: the part of polygon ``buf[i, :n]`` inside lu x + lw y <= lo, written
     to ``buf[1 - i]``; returns its vertex count (0 when nothing is left). Buffers are addressed by
@@ -45,7 +45,7 @@ def clip_halfplane(buf: np.ndarray, i: int, n: int, lu: float, lw: float, lo: fl
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def polygon_area(buf: np.ndarray, b: int, n: int) -> float:
     """Area of polygon ``buf[b, :n]`` (positive when counter-clockwise) [m^2]."""
     a = 0.0
@@ -55,7 +55,7 @@ def polygon_area(buf: np.ndarray, b: int, n: int) -> float:
     return 0.5 * a
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def nearest_on_polygon(buf: np.ndarray, b: int, n: int, x: float, y: float) -> tuple[float, float]:
     """Point of the boundary of polygon ``buf[b, :n]`` nearest to (x, y)."""
     best = np.inf
@@ -74,7 +74,7 @@ def nearest_on_polygon(buf: np.ndarray, b: int, n: int, x: float, y: float) -> t
     return bx, by
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def deepest_vertex(
     buf: np.ndarray, b: int, n: int, hu: float, hw: float, x: float, y: float, tie: float
 ) -> tuple[float, float]:
@@ -94,7 +94,7 @@ def deepest_vertex(
     return bx, by
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def segment_closest(
     p0: float, p1: float, p2: float, d0: float, d1: float, d2: float,
     q0: float, q1: float, q2: float, e0: float, e1: float, e2: float,

@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def quat_to_matrix(q: np.ndarray, r: np.ndarray) -> None:
     """Write the rotation matrix of unit quaternion ``q`` (4,) into ``r`` (3, 3)."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -23,7 +23,7 @@ def quat_to_matrix(q: np.ndarray, r: np.ndarray) -> None:
     r[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def quat_integrate(q: np.ndarray, wb: np.ndarray, dt: float) -> None:
     """q <- q * exp(wb dt / 2) in place: rotate by body-frame angular velocity ``wb`` [rad/s] over dt."""
     wx, wy, wz = wb[0] * dt, wb[1] * dt, wb[2] * dt

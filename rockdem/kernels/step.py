@@ -53,7 +53,7 @@ DIVERGENCE_ERROR = 0.2
 """Energy-balance error, as a fraction of the run's energy scale so far, that marks a divergence."""
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def integrate_velocities(
     m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int
 ) -> None:
@@ -162,7 +162,7 @@ def integrate_velocities(
         _record_counts(s, sc, rec, frame)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _record_counts(s: State, sc: Scratch, rec: Records, frame: int) -> None:
     bonded = 0
     ften = 0
@@ -183,7 +183,7 @@ def _record_counts(s: State, sc: Scratch, rec: Records, frame: int) -> None:
         rec.reaction[frame, i] = sc.reaction[i]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, _nrt=False, inline="always")
 def _dashpot_power(s: State, sc: Scratch, o: int, t: int, fd: np.ndarray, c: np.ndarray) -> float:
     """-F_d . v_rel at the step mid-point velocities (the same that change the kinetic energy)."""
     wo = sc.omega_mid[o]
@@ -196,7 +196,7 @@ def _dashpot_power(s: State, sc: Scratch, o: int, t: int, fd: np.ndarray, c: np.
     return -(fd[0] * v0 + fd[1] * v1 + fd[2] * v2)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def dashpot_work(m: ModelArrays, s: State, sc: Scratch, h: float) -> None:
     """Energy dissipated by the SP dashpots over the step: -F_d . v_rel(mid-step) h, the same
     velocities that change the kinetic energy, so that the energy balance closes."""
@@ -217,7 +217,7 @@ def dashpot_work(m: ModelArrays, s: State, sc: Scratch, h: float) -> None:
     s.energy[E_DAMPING_STIFFNESS] += e
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def integrate_positions(m: ModelArrays, s: State, dt: float) -> None:
     """x_{n+1} = x_n + v_{n+1/2} dt; quaternions by the exponential map; movement since detection."""
     for b in range(m.block_mass.shape[0]):
@@ -231,7 +231,7 @@ def integrate_positions(m: ModelArrays, s: State, dt: float) -> None:
         s.moved[b] += (math.sqrt(v2) + math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2) * m.block_radius[b]) * dt
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int) -> int:
     """Status of recorded frame ``frame``: STATUS_DIVERGED when the state is not finite or energy
     was created: the mechanical energy (kinetic + potential + elastic) exceeds its initial value
@@ -279,11 +279,6 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     return STATUS_DONE
 
 
-# The time loop is compiled without Numba's reference counting (``_nrt=False``): the arrays it is
-# given are owned by the caller for the whole call, and with counting on, every call of a kernel
-# with the model, state and scratch tuples counted their ~150 arrays in and out (two atomic
-# operations each), which was 90 % of a step for small models (Table 2 block: 6.7 -> 0.8 us per
-# step). Kernels that allocate (the detection's sorts) still count their own arrays.
 @njit(cache=True, _nrt=False)
 def advance(
     m: ModelArrays, s: State, sc: Scratch, t_stop: float, record_interval: float, rec: Records, frame: int
