@@ -99,14 +99,16 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, 
             area = min(m.edge_area[ea], m.edge_area[eb])
             _add_contact(m, s, sc, row, beta, a, b, x0, x1, x2, s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2], area)
             continue
-        ft = s.pair_target_face[i]
-        t = m.face_block[ft]
-        rt = sc.rotation[t]
-        fn = m.face_normal[ft]
-        n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
-        n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
-        n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
+        split = s.pair_track_split[i]
         for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            # The owner's points press on the target face, the target's (kernels.blend) on the owner.
+            ft = s.pair_target_face[i] if k < split else s.pair_owner_face[i]
+            t = m.face_block[ft]
+            rt = sc.rotation[t]
+            fn = m.face_normal[ft]
+            n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
+            n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
+            n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
             p = s.track[k] // SLOTS
             o = m.point_block[p]
             ro = sc.rotation[o]
