@@ -218,6 +218,7 @@ class RunOptions:
     resolution: float = 0.3
     record_interval: float = 0.002
     contact_tolerance: float | None = None
+    contact_interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -470,6 +471,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         resolution=run_t.number("resolution", 0.3, positive=True),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
+        contact_interval=run_t.optional_number("contact_interval", positive=True),
     )
     run_t.finish()
     damp_t = top.sub("damping")
@@ -499,6 +501,9 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         "directory": out_t.string("directory", ""),
         "plot": out_t.boolean("plot", True),
         "csv": out_t.boolean("csv", True),
+        "checkpoint": out_t.boolean("checkpoint", True),
+        "checkpoint_every": out_t.optional_number("checkpoint_every", positive=True),
+        "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
     top.finish()

@@ -40,16 +40,19 @@ from __future__ import annotations
 import os
 import uuid
 from pathlib import Path
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 import xarray as xr
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv"]
+__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv", "contact_table", "write_contact_table"]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -287,4 +290,80 @@ def export_csv(ds: xr.Dataset, path: str | Path) -> Path:
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(cols).to_csv(p, index=False)
+    return p
+
+
+def contact_table(ds: xr.Dataset) -> "pd.DataFrame":
+    """The contact snapshots of a result (run with ``contact_interval``) as one long table: a row per
+    snapshot and sub-contact (interface point with a partner block).
+
+    Columns: time [s], point, block, partner (names), x, y, z [m] (world), nx, ny, nz (unit normal of
+    the partner face, into ``block``), normal_force [N] (elastic, compression > 0), shear_force [N]
+    (magnitude), fnx, fny, fnz and fsx, fsy, fsz [N] (the elastic normal and shear force vectors on
+    ``block``, world), bonded (bool), failed (0 intact, 1 tension, 2 shear), area [m^2] (tributary).
+
+    Raises:
+        ValueError: the result has no contact snapshots.
+    """
+    import pandas as pd
+
+    if "contact_time" not in ds.coords:
+        raise ValueError("the result has no contact snapshots: run it with contact_interval "
+                         "([run] contact_interval = 0.05 in the case file, or --set run.contact_interval=0.05)")
+    partner = ds.point_partner.values
+    snap, point = np.nonzero(partner >= 0)
+    names = np.asarray(ds.block_name.values, dtype=object)
+    fn = ds.point_normal_force.values[snap, point]
+    normal = ds.point_normal.values[snap, point] if "point_normal" in ds else np.full((snap.size, 3), np.nan)
+    fs = (ds.point_shear_force_vector.values[snap, point] if "point_shear_force_vector" in ds
+          else np.full((snap.size, 3), np.nan))
+    pos = ds.point_position.values[snap, point]
+    cols: dict[str, np.ndarray] = {
+        "time": ds.contact_time.values[snap],
+        "point": point,
+        "block": names[ds.point_block.values[point]],
+        "partner": names[partner[snap, point]],
+        "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
+        "nx": normal[:, 0], "ny": normal[:, 1], "nz": normal[:, 2],
+        "normal_force": fn,
+        "shear_force": ds.point_shear_force.values[snap, point],
+        "fnx": fn * normal[:, 0], "fny": fn * normal[:, 1], "fnz": fn * normal[:, 2],
+        "fsx": fs[:, 0], "fsy": fs[:, 1], "fsz": fs[:, 2],
+        "bonded": ds.point_bonded.values[snap, point] > 0,
+        "failed": ds.point_failed.values[snap, point].astype(np.int8),
+        "area": ds.point_area.values[point],
+    }
+    return pd.DataFrame(cols)
+
+
+def _has_pyarrow() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("pyarrow") is not None
+
+
+def write_contact_table(ds: xr.Dataset, path: str | Path, fmt: str = "auto") -> Path:
+    """Write :func:`contact_table` as CSV or Parquet; returns the path written.
+
+    Args:
+        path: the file; with ``fmt="auto"`` and no .csv/.parquet suffix, the suffix is chosen:
+            .parquet when pyarrow is installed, else .csv.
+        fmt: "auto" (by suffix, as above), "csv" or "parquet" (needs pyarrow).
+    """
+    p = Path(path)
+    if fmt not in ("auto", "csv", "parquet"):
+        raise ValueError(f"contact table format must be 'auto', 'csv' or 'parquet', got {fmt!r}")
+    if fmt == "auto":
+        fmt = p.suffix.lower().lstrip(".") if p.suffix.lower() in (".csv", ".parquet") else (
+            "parquet" if _has_pyarrow() else "csv")
+    if fmt == "parquet" and not _has_pyarrow():
+        raise ValueError(f"{p}: Parquet needs pyarrow (pip install pyarrow); write a .csv instead")
+    if p.suffix.lower() != f".{fmt}":
+        p = p.with_name(p.name + f".{fmt}") if p.suffix.lower() not in (".csv", ".parquet") else p.with_suffix(f".{fmt}")
+    table = contact_table(ds)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "parquet":
+        table.to_parquet(p, index=False)
+    else:
+        table.to_csv(p, index=False)
     return p
