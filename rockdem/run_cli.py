@@ -167,37 +167,40 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
 
 
 def plot_rocking(ds: xr.Dataset, path: Path) -> Path:
-    """Rotation and top displacement versus time, saved as PNG."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Rotation and top displacement versus time (and the input motion of an earthquake run),
+    saved as PNG."""
+    from .plots import InlineFigure, STYLE, ground_acceleration, save_figure
+    from matplotlib import rc_context
 
     free = np.flatnonzero(ds.block_free.values)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    t = ds.time.values
-    for b in free:
-        axes[0].plot(t, np.degrees(ds.rocking_angle.values[:, b]), label=str(ds.block_name.values[b]))
-    axes[0].set_ylabel("rocking angle [deg]")
-    axes[0].grid(True, alpha=0.3)
-    if len(free) <= 8:
-        axes[0].legend(loc="upper right", fontsize=8)
-    if ds.sizes.get("monitor", 0):
-        for j, name in enumerate(ds.monitor.values):
-            axes[1].plot(t, ds.monitor_displacement.values[:, j, 0] * 1e3, label=f"{name} (x)")
-        axes[1].set_ylabel("displacement [mm]")
-        axes[1].legend(loc="upper right", fontsize=8)
-    else:
+    quake = ground_acceleration(ds)
+    with rc_context(STYLE):
+        fig = InlineFigure(figsize=(8, 6 if quake is None else 9.5))
+        axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
+        t = ds.time.values
         for b in free:
-            axes[1].plot(t, ds.block_displacement.values[:, b, 0] * 1e3)
-        axes[1].set_ylabel("centroid displacement x [mm]")
-    axes[1].set_xlabel("time [s]")
-    axes[1].grid(True, alpha=0.3)
-    fig.tight_layout()
+            axes[0].plot(t, np.degrees(ds.rocking_angle.values[:, b]), label=str(ds.block_name.values[b]))
+        axes[0].set_ylabel("rocking angle [deg]")
+        if len(free) <= 8:
+            axes[0].legend(loc="upper right", fontsize=8)
+        if ds.sizes.get("monitor", 0):
+            for j, name in enumerate(ds.monitor.values):
+                axes[1].plot(t, ds.monitor_displacement.values[:, j, 0] * 1e3, label=f"{name} (x)")
+            axes[1].set_ylabel("displacement [mm]")
+            axes[1].legend(loc="upper right", fontsize=8)
+        else:
+            for b in free:
+                axes[1].plot(t, ds.block_displacement.values[:, b, 0] * 1e3)
+            axes[1].set_ylabel("centroid displacement x [mm]")
+        if quake is not None:
+            from .spectra import plot_ground_motion_axes
+
+            plot_ground_motion_axes(tuple(axes[2:]), t, quake)
+        axes[-1].set_xlabel("time [s]")
+        fig.align_ylabels()
+        fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def _output_folder(path: Path, what: str, files: tuple[str, ...]) -> Path:
