@@ -221,7 +221,7 @@ class RunOptions:
     contact_interval: float | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Case:
     """A built case: the model, run options, monitors and output settings, plus what the loading
     adds to the result: ``attrs`` (scalars, e.g. the pushover ramp, the record and its PGA, the tilt
@@ -235,6 +235,17 @@ class Case:
     data: dict[str, Any]
     attrs: dict[str, Any] = field(default_factory=dict)
     series: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        model = repr(self.model).split("\n", 1)[1]
+        return f"rockdem Case {self.name!r}: {run}, monitors {sorted(self.monitors)}\n{model}"
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        return f"<b>rockdem Case {escape(self.name)}</b>: {escape(run)}<br>{self.model._repr_html_()}"
 
 
 SpecimenBuilder = Callable[[Table, ModelBuilder], dict[str, Monitor]]

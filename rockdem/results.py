@@ -1,5 +1,11 @@
 """Results as an xarray Dataset: building, saving to NetCDF, CSV export, loading.
 
+Coordinates: ``time`` [s]; ``block``: the block names, so that ``ds.sel(block="wall")`` selects a
+block by name; ``block_id`` (block): the integer ids, indexed too: ``ds.sel(block_id=1)`` or
+``ds.isel(block=1)`` (the id is the position); ``monitor`` and ``driven_block`` names. Results
+written before the names became the coordinate hold the ids in ``block`` (positional access with
+``.values[:, b]`` and ``isel`` works for both).
+
 Variables (dims; units in each variable's ``units`` attribute):
   block_position (time, block, xyz) [m]        centroid
   block_quaternion (time, block, quat)         body principal frame -> world (w, x, y, z)
@@ -52,7 +58,8 @@ from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv", "contact_table", "write_contact_table"]
+__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv", "contact_table", "write_contact_table",
+           "with_block_index"]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -77,7 +84,9 @@ def build_dataset(
     rel_ref = np.einsum("tbij,bkj->tbik", r, rref)  # rotation since the untilted reference
     rotvec = rotation_vector(rel_ref)
     axis = model.rocking_axis
-    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": np.arange(model.block_count)})
+    names = np.array(model.block_names, dtype=object)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": ("block", names, {"note": "block name"})})
+    ds = with_block_index(ds.assign_coords(block_id=("block", np.arange(model.block_count), {"note": "block id"})))
     xyz = ("time", "block", "xyz")
     ds["block_position"] = (xyz, rec.position, {"units": "m"})
     ds["block_quaternion"] = (("time", "block", "quat"), rec.quaternion, {"units": "1"})
@@ -233,8 +242,8 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out = ds.copy()
     for name in ("block_group", "block_name"):
         out[name] = out[name].astype(str)
-    for coord in ("monitor", "driven_block"):
-        if coord in out.coords:
+    for coord in ("block", "monitor", "driven_block"):
+        if coord in out.coords and out[coord].dtype == object:
             out = out.assign_coords({coord: out[coord].astype(str)})
     out["block_free"] = out["block_free"].astype(np.int8)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
@@ -254,6 +263,14 @@ def load(path: str | Path) -> xr.Dataset:
         raise FileNotFoundError(f"no result file at {p}")
     ds = xr.load_dataset(p)
     ds["block_free"] = ds["block_free"].astype(bool)
+    return with_block_index(ds)
+
+
+def with_block_index(ds: xr.Dataset) -> xr.Dataset:
+    """Index the ``block_id`` coordinate (if any) so that ``ds.sel(block_id=1)`` selects by id, as
+    ``ds.sel(block="wall")`` does by name (an index is not stored in NetCDF: :func:`load` adds it)."""
+    if "block_id" in ds.coords and "block_id" not in ds.xindexes:
+        ds = ds.set_xindex("block_id")
     return ds
 
 
@@ -367,3 +384,37 @@ def write_contact_table(ds: xr.Dataset, path: str | Path, fmt: str = "auto") -> 
     else:
         table.to_csv(p, index=False)
     return p
+
+
+@xr.register_dataset_accessor("rockdem")
+class ResultSummary:
+    """``ds.rockdem``: a short summary of a rockdem result (the run's summary table: steps,
+    timestep, peaks, energy balance, failed sub-contacts, rocking analysis), shown as text by
+    ``print(ds.rockdem)`` and as a table in a notebook; ``ds.rockdem.plot(kind)`` draws one of
+    :data:`rockdem.plots.PLOTS`."""
+
+    def __init__(self, ds: xr.Dataset) -> None:
+        self._ds = ds
+
+    def lines(self) -> list[str]:
+        """The summary rows (as printed by ``rockdem run``)."""
+        from .run_cli import summary_lines
+
+        return summary_lines(self._ds)
+
+    def __repr__(self) -> str:
+        name = self._ds.attrs.get("name", "")
+        return f"rockdem result{' ' + str(name) if name else ''}\n" + "\n".join("  " + line for line in self.lines())
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        return "<b>rockdem result</b><pre>" + escape("\n".join(self.lines())) + "</pre>"
+
+    def plot(self, kind: str = "history", **options: object) -> object:
+        """A figure of :data:`rockdem.plots.PLOTS` (``"history"``, ``"energy"``, ...), shown inline."""
+        from .plots import PLOTS
+
+        if kind not in PLOTS:
+            raise ValueError(f"plot kind {kind!r} unknown; use one of {sorted(PLOTS)}")
+        return PLOTS[kind](self._ds, **options)

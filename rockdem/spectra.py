@@ -26,7 +26,7 @@ DEFAULT_PERIODS: NDArray[np.float64] = np.geomspace(0.02, 5.0, 80)
 """Oscillator periods [s] of the default spectrum (log-spaced, 0.02 to 5 s)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Spectrum:
     """An elastic response spectrum.
 
@@ -51,6 +51,11 @@ class Spectrum:
     def psv(self) -> NDArray[np.float64]:
         """(k,) pseudo-spectral velocity PSA / omega [m/s]."""
         return self.psa * self.period / (2.0 * np.pi)
+
+    def __repr__(self) -> str:
+        k = int(np.argmax(self.psa))
+        return (f"Spectrum({self.name!r}, {self.period.size} periods {self.period[0]:g}..{self.period[-1]:g} s, "
+                f"damping {self.damping:g}, peak PSA {self.psa[k]:.4g} m/s^2 at T = {self.period[k]:.3g} s)")
 
     def at(self, period: float) -> float:
         """PSA [m/s^2] at ``period`` [s] (log-log interpolation between the computed periods)."""
