@@ -146,3 +146,20 @@ def test_cli_run_from_checkpoint_equals_one_run(tmp_path):
     assert_identical(load(tmp_path / "one" / "result.nc"), load(tmp_path / "two" / "result.nc"))
     assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "three"), "--from", str(ck), "--settled", str(ck)]) == 2
     assert main(args + ["--set", "damping.beta=0.002", "--out", str(tmp_path / "four"), "--from", str(ck)]) == 2
+
+
+def test_settled_state_starts_an_earthquake_case(tmp_path):
+    # settle the El Centro example's block under gravity alone, then run the earthquake case from it
+    from pathlib import Path
+
+    from rockdem.case import load_case
+
+    quake = load_case(Path(__file__).resolve().parents[1] / "examples" / "elcentro_block_foundation.toml")
+    gravity = parse_case({**quake, "loading": {"type": "gravity"}}).model
+    model = parse_case(quake).model
+    assert structure_hash(gravity) == structure_hash(model) and model_hash(gravity) != model_hash(model)
+    simulate(gravity, 0.2, checkpoint=tmp_path / "s.npz", **RUN)
+    start = Checkpoint.load(tmp_path / "s.npz").reset_clock()
+    ds = simulate(model, 0.3, initial=start, **RUN)
+    np.testing.assert_array_equal(ds.block_position.values[0], start.state.position)
+    assert ds.attrs["steps"] > 0 and ds.time.values[0] == 0.0
