@@ -199,6 +199,9 @@ class Checkpoint:
         try:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, **arrays)
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes it private)
             os.replace(tmp, p)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
