@@ -7,20 +7,27 @@ breaks or its state is no longer finite (diverged), or when a free block leaves 
 (it fell through its support or flew away); the result keeps the frames before it and says where
 (``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
 ``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
-``interrupted``.
+``interrupted``. A run can be saved to a checkpoint and continued exactly (:mod:`rockdem.checkpoint`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import signal
+import threading
 import time as _time
 import warnings
-from typing import Any, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 import xarray as xr
 
-from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, new_records
+from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
+from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
 from .results import build_dataset
@@ -44,26 +51,32 @@ def simulate(
     duration: float,
     *,
     dt: float | None = None,
-    timestep_rule: str = "bound",
-    safety: float = DEFAULT_SAFETY,
-    resolution: float = DEFAULT_RESOLUTION,
-    record_interval: float = 0.002,
+    timestep_rule: str | None = None,
+    safety: float | None = None,
+    resolution: float | None = None,
+    record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
     contact_interval: float | None = None,
     max_steps: int = DEFAULT_MAX_STEPS,
+    initial: Checkpoint | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float | None = None,
 ) -> xr.Dataset:
-    """Run ``model`` for ``duration`` seconds and return the recorded histories.
+    """Run ``model`` until time ``duration`` and return the recorded histories.
 
     Args:
         model: a finalized model (:meth:`rockdem.model.ModelBuilder.finalize`).
-        duration: simulated time [s].
+        duration: simulated time at the end of the run [s] (continuing a checkpoint: the end time,
+            not the time added).
         dt: timestep [s]; default automatic (see :mod:`rockdem.timestep`); refused above the bound.
         timestep_rule: "bound" (default) or "3dec" (0.2 sqrt(m_min/k_max)).
-        safety: fraction of the stable bound for the automatic timestep.
-        resolution: largest omega_max dt / 2, so that impacts last several steps and keep their
-            energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
-        record_interval: time between recorded frames [s] (rounded to whole steps).
+        safety: fraction of the stable bound for the automatic timestep (default 0.9).
+        resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
+            keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
+        record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
+            the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
+            within half a step of it.
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
             configuration (before any initial tilt); displacements are measured from there.
@@ -72,42 +85,48 @@ def simulate(
             default None: none recorded.
         max_steps: a run estimated to need more steps (duration / initial dt) is refused before it
             starts, with the estimate: an absurd stiffness, mass or damping would otherwise hang.
+        initial: a :class:`~rockdem.checkpoint.Checkpoint` (or its file) to continue: the result
+            holds the checkpoint's frames followed by the new ones, bit for bit those of an
+            uninterrupted run. The timestep and the record and contact intervals are the
+            checkpoint's (giving other values is an error). A checkpoint whose clock was reset
+            (:meth:`~rockdem.checkpoint.Checkpoint.reset_clock`) instead starts a new run at t = 0
+            from its state, on a model with the same blocks and any loading.
+        checkpoint: file written at the end of the run, when it is interrupted (Ctrl-C, or SIGTERM
+            under ``rockdem run``), and every ``checkpoint_every`` seconds of wall time; none is
+            written for a run that diverged.
+        checkpoint_every: wall time between checkpoints during the run [s]; default only at the end.
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
 
     Raises:
         TypeError: ``model`` is not a finalized Model.
-        ValueError: bad options, a timestep longer than the run, or more steps than ``max_steps``.
+        ValueError: bad options, a timestep longer than the run, more steps than ``max_steps``, or
+            a checkpoint of another model.
     """
     if not isinstance(model, Model):
         hint = " (call builder.finalize() first)" if type(model).__name__ == "ModelBuilder" else ""
         raise TypeError(f"simulate: model must be a rockdem Model{hint}, got {type(model).__name__}")
     duration = _positive_number("duration", duration, "s")
-    record_interval = _positive_number("record_interval", record_interval, "s")
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
         raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if checkpoint_every is not None:
+        checkpoint_every = _positive_number("checkpoint_every", checkpoint_every, "s of wall time")
+        if checkpoint is None:
+            raise ValueError("checkpoint_every needs a checkpoint file: give checkpoint=PATH")
     mon = _check_monitors(model, monitors or {})
-    snaps = ContactSnapshots(model, contact_interval)
-    info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
-    _check_step_count(info, duration, max_steps)
-    frames = int(math.floor(duration / record_interval + 1e-9)) + 1
-    need = frames * model.block_count * 13 * 8
-    if need > _MAX_RECORD_BYTES:
-        raise ValueError(
-            f"recording {frames} frames of {model.block_count} blocks needs {need / 1e9:.1f} GB; "
-            f"raise record_interval (now {record_interval} s)"
-        )
+    ck = None if initial is None else load_checkpoint(initial)
     wall0 = _time.perf_counter()
-    state, scratch = initial_state(model)
-    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
-    state.safety[0] = safety
-    state.resolution[0] = resolution if info.rule == "bound" else 1.0
+    if ck is None or ck.fresh:
+        run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+                         contact_interval, max_steps)
+    else:
+        run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+                             contact_interval, max_steps)
+    saver = _Saver(model, run, checkpoint, checkpoint_every)
+    info, state, scratch, rec, snaps = run.info, run.state, run.scratch, run.records, run.snaps
+    frame, frames = run.frame, rec.time.shape[0]
     m = model.arrays
-    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
-    snaps.take(state)
-    rec = new_records(frames, model.block_count, int(np.count_nonzero(~m.block_free.astype(bool))))
-    frame = 0
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
     thickness = _block_thickness(model)
@@ -117,22 +136,26 @@ def simulate(
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
         while state.time[0] < t_end and frame < frames:
-            stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
-            t0 = _time.perf_counter()
-            frame, status = advance(m, state, scratch, stop, record_interval, rec, frame)
-            elapsed = _time.perf_counter() - t0
-            if status == STATUS_GROW:
-                state, scratch = grow_buffers(state, scratch)
-                continue
-            if status != STATUS_DONE:
-                break
-            sunk = _sunk(model, state, thickness)
-            if sunk is not None:
-                break
-            snaps.take(state)
+            # A stop signal during a chunk is raised once the chunk's bookkeeping is done, so that the
+            # state, the frame counter and the snapshots saved in a checkpoint belong together.
+            with _deferred_signals():
+                stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
+                t0 = _time.perf_counter()
+                frame, status = advance(m, state, scratch, stop, run.record_interval, rec, frame)
+                elapsed = _time.perf_counter() - t0
+                if status == STATUS_GROW:
+                    state, scratch = grow_buffers(state, scratch)
+                    continue
+                if status != STATUS_DONE:
+                    break
+                sunk = _sunk(model, state, thickness)
+                if sunk is not None:
+                    break
+                snaps.take(state)
             chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+            saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0)
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
-                bar = _progress_bar(duration)
+                bar = _progress_bar(duration, run.start_time)
             if bar is not None:
                 bar.update(min(float(state.time[0]), duration) - bar.n)
     except KeyboardInterrupt:
@@ -140,7 +163,7 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
-    runtime = _time.perf_counter() - wall0
+    runtime = _time.perf_counter() - wall0 + run.runtime_before
     attrs: dict[str, Any] = {
         "dt": info.dt,
         "dt_min": float(state.dt_min[0]),
@@ -152,9 +175,11 @@ def simulate(
         "steps": int(state.step[0]),
         "runtime_s": runtime,
         "duration": duration,
-        "record_interval": record_interval,
+        "record_interval": run.record_interval,
         "interrupted": int(interrupted),
     }
+    if run.continued_from is not None:
+        attrs["continued_from_time"] = run.continued_from
     if status in (STATUS_DIVERGED, STATUS_LOST):
         attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
         warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
@@ -166,6 +191,10 @@ def simulate(
         attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                       "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
+    elif checkpoint is not None:
+        attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime))
+    if attrs.get("diverged") and checkpoint is not None:
+        attrs["checkpoint_note"] = "no checkpoint written: the run diverged"
     fell = np.flatnonzero(state.fell_off >= 0.0)
     if fell.size:
         listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
@@ -179,6 +208,146 @@ def simulate(
     rec = Records(*(a[:frame] for a in rec))
     ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
     return snaps.attach(ds)
+
+
+@dataclass
+class _Run:
+    """What the time loop starts from: a fresh state, or a checkpoint's."""
+
+    info: TimestepInfo
+    state: State
+    scratch: Scratch
+    records: Records  # preallocated for every frame of the run, the first ``frame`` filled
+    frame: int
+    record_interval: float
+    snaps: ContactSnapshots
+    start_time: float = 0.0
+    runtime_before: float = 0.0
+    continued_from: float | None = None
+
+
+def _frames(model: Model, duration: float, record_interval: float) -> Records:
+    """Zeroed records for every frame of a run to ``duration`` [s], refused above 2 GB."""
+    frames = int(math.floor(duration / record_interval + 1e-9)) + 1
+    need = frames * model.block_count * 13 * 8
+    if need > _MAX_RECORD_BYTES:
+        raise ValueError(
+            f"recording {frames} frames of {model.block_count} blocks needs {need / 1e9:.1f} GB; "
+            f"raise record_interval (now {record_interval} s)"
+        )
+    driven = int(np.count_nonzero(~model.arrays.block_free.astype(bool)))
+    return new_records(frames, model.block_count, driven)
+
+
+def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float | None, rule: str | None,
+               safety: float | None, resolution: float | None, record_interval: float | None,
+               contact_interval: float | None, max_steps: int) -> _Run:
+    """A run from t = 0: the model's initial state, or a checkpoint's state with its clock reset."""
+    interval = _positive_number("record_interval", 0.002 if record_interval is None else record_interval, "s")
+    safety = DEFAULT_SAFETY if safety is None else safety
+    resolution = DEFAULT_RESOLUTION if resolution is None else resolution
+    snaps = ContactSnapshots(model, contact_interval)
+    info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt)
+    _check_step_count(info, duration, max_steps)
+    rec = _frames(model, duration, interval)
+    if ck is None:
+        state, scratch = initial_state(model)
+    else:
+        ck.check_model(model)
+        state, scratch = ck.engine_arrays(model)
+        scratch.lost_block[:] = -1
+    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
+    state.safety[0] = safety
+    state.resolution[0] = resolution if info.rule == "bound" else 1.0
+    m = model.arrays
+    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
+    snaps.take(state)
+    return _Run(info, state, scratch, rec, 0, interval, snaps)
+
+
+def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | None, rule: str | None,
+                   safety: float | None, resolution: float | None, record_interval: float | None,
+                   contact_interval: float | None, max_steps: int) -> _Run:
+    """The run saved in ``ck``, continued to ``duration``: its state, frames and snapshots."""
+    ck.check_model(model)
+    given = {"dt": (dt, ck.timestep.dt if ck.timestep.rule == "user" else None),
+             "timestep_rule": (rule, ck.timestep.rule if ck.timestep.rule != "user" else None),
+             "safety": (safety, float(ck.state.safety[0])),
+             "resolution": (resolution, float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
+             "record_interval": (record_interval, ck.record_interval),
+             "contact_interval": (contact_interval, ck.contact_interval)}
+    for name, (value, saved) in given.items():
+        if value is not None and value != saved:
+            raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
+                             f"the options it was started with; leave {name} unset")
+    if not duration > ck.time:
+        raise ValueError(f"the checkpoint is already at t = {ck.time:.6g} s: give a duration (the end time) beyond it")
+    _check_step_count(ck.timestep, duration - ck.time, max_steps)
+    state, scratch = ck.engine_arrays(model)
+    rec = _frames(model, duration, ck.record_interval)
+    if ck.frame > rec.time.shape[0]:
+        raise ValueError(f"the checkpoint holds {ck.frame} frames, more than a run to {duration:g} s records")
+    for dst, src in zip(rec, ck.records):
+        dst[: ck.frame] = src[: ck.frame]
+    snaps = ContactSnapshots(model, ck.contact_interval)
+    snaps.restore(ck.snapshots, ck.snapshot_count)
+    return _Run(ck.timestep, state, scratch, rec, ck.frame, ck.record_interval, snaps, ck.time, ck.runtime_s, ck.time)
+
+
+class _Saver:
+    """Writes the run's checkpoint file (at the end, on interruption, every ``every`` s of wall time)."""
+
+    def __init__(self, model: Model, run: _Run, path: str | os.PathLike[str] | None, every: float | None) -> None:
+        self.model, self.run, self.path, self.every = model, run, path, every
+        self.last = _time.perf_counter()
+        self.hashes = (model_hash(model), structure_hash(model)) if path is not None else ("", "")
+
+    def save(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
+             runtime: float) -> Path:
+        """Write the checkpoint now (state after the last completed chunk, frames ``[:frame]``)."""
+        assert self.path is not None
+        ck = Checkpoint(
+            state=state, scratch=scratch, records=Records(*(a[:frame] for a in rec)), frame=frame,
+            record_interval=self.run.record_interval, contact_interval=snaps.interval, snapshot_count=snaps.count,
+            snapshots=snaps.columns() if snaps.interval else {}, timestep=self.run.info,
+            model_hash=self.hashes[0], structure_hash=self.hashes[1], runtime_s=runtime,
+            block_names=self.model.block_names,
+        )
+        with _deferred_signals():
+            p = ck.save(self.path)
+        self.last = _time.perf_counter()
+        return p
+
+    def maybe(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
+              wall: float) -> None:
+        """Save if ``every`` seconds of wall time passed since the last save."""
+        if self.every is not None and _time.perf_counter() - self.last >= self.every:
+            self.save(state, scratch, rec, frame, snaps, wall + self.run.runtime_before)
+
+
+@contextlib.contextmanager
+def _deferred_signals() -> Iterator[None]:
+    """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
+    deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
+    halfway through it. Outside the main thread (where no signal arrives) this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[tuple[int, Any]] = []
+    old: dict[int, Any] = {}
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        handler = signal.getsignal(sig) if sig is not None else None
+        if callable(handler):
+            old[sig] = handler
+            signal.signal(sig, lambda signum, frame: held.append((signum, frame)))
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+        for signum, frame in held[:1]:
+            old[signum](signum, frame)
 
 
 SINK_FRACTION = 0.25
@@ -274,11 +443,12 @@ def _failure(model: Model, rec: Records, bad: int, status: int, block: int, step
     }
 
 
-def _progress_bar(duration: float) -> Any:
+def _progress_bar(duration: float, start: float = 0.0) -> Any:
     from tqdm.auto import tqdm
 
     return tqdm(
         total=duration,
+        initial=start,
         unit="s",
         desc="rockdem",
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3f}/{total:.3f} s simulated [{elapsed}<{remaining}]",
