@@ -218,160 +218,179 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
         a = m.face_block[fa]
         b = m.face_block[fb]
         split = s.pair_track_split[i]
+        stop = s.pair_track_stop[i]
         lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
-        ga = m.block_group[a]
-        gb = m.block_group[b]
-        kn = m.mat_kn[ga, gb]
-        ks = m.mat_ks[ga, gb]
-        beta = m.mat_beta[ga, gb]
-        go, gt = ga, gb
-        u_owner = 0.0
-        u_target = 0.0
-        for side in range(2):
-            k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
-            if k0 == k1:
-                continue
-            fo, ft = (fa, fb) if side == 0 else (fb, fa)
-            o, t = (a, b) if side == 0 else (b, a)
-            wgt = 1.0 - lam if side == 0 else lam
-            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-            n0, n1, n2 = fm.nx, fm.ny, fm.nz
-            u_side = 0.0
-            for k in range(k0, k1):
-                code = s.track[k]
-                p = code // SLOTS
-                j = code - SLOTS * p
-                sc.dashpot_force[k, 0] = 0.0
-                sc.dashpot_force[k, 1] = 0.0
-                sc.dashpot_force[k, 2] = 0.0
-                sc.contact_force[k, 0] = 0.0
-                sc.contact_force[k, 1] = 0.0
-                sc.contact_force[k, 2] = 0.0
-                full_area = sc.track_area[k]
-                area = full_area * wgt  # this side's share (kernels.blend); 0 switches it off
-                sc.track_area[k] = area
-                yu = sc.track_point_u[k]
-                yw = sc.track_point_w[k]
-                un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + sc.track_depth_shift[k]
-                un_prev = s.slot_overlap[p, j]
-                s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
-                us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
-                bonded = s.slot_bonded[p, j]
-                prev_area = s.slot_area[p, j]
-                s.slot_area[p, j] = area
-                # Contact point: midway between the owner-plane point and the target plane.
-                x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
-                x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
-                x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
-                v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
-                vn = v0 * n0 + v1 * n1 + v2 * n2  # > 0: separating
-                vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
-                kna = kn * area
-                ksa = ks * area
-                fn = kna * un
-                opened = area <= 0.0 or (un <= 0.0 and not bonded)
-                if not opened and bonded and fn < -m.mat_tension[go, gt] * area:
-                    # Tension cut-off: the bond fails and the point opens.
-                    e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
-                    s.slot_bonded[p, j] = False
-                    s.point_failed[p] = FAILED_TENSION
-                    opened = True
-                    bonded = False
-                    prev_area = 0.0  # its energy is counted
-                if opened:
-                    # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
-                    e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
-                    if bonded:
-                        e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
-                        s.slot_bonded[p, j] = False
-                        s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
-                    elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
-                        # Opened during the last step: its release is computed apart (release pass), its
-                        # shear extension kept until then.
-                        sc.pending[nrel] = k
-                        sc.pending_pair[nrel] = i
-                        sc.release_overlap[nrel] = un_prev
-                        sc.release_area[nrel] = prev_area
-                        nrel += 1
-                        s.slot_normal_force[p, j] = 0.0
-                        continue
-                    else:
-                        e_fric += e
-                    s.slot_shear[p, j, 0] = 0.0
-                    s.slot_shear[p, j, 1] = 0.0
-                    s.slot_shear[p, j, 2] = 0.0
-                    s.slot_normal_force[p, j] = 0.0
-                    continue
-                # An unbonded contact that closed during the last step: its springs act since the crossing
-                # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
-                ramp = 1.0
-                since = dt
-                if not bonded and un_prev <= 0.0 and vn < 0.0:
-                    since = min(un / (-vn * dt), 1.0) * dt
-                    ramp = ramp_overlap(un, un_prev, vn, dt) / un
-                f_applied = fn * ramp
-                us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
-                trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
-                if bonded:
-                    fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
-                else:
-                    fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
-                slipping = trial > fmax
-                gone = False
-                if slipping:
-                    e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
-                    if bonded:
-                        # Shear failure: drop to the residual strength; the released energy is the bond's.
-                        s.slot_bonded[p, j] = False
-                        s.point_failed[p] = FAILED_SHEAR
-                        fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
-                        e_bond += drop_dissipation(fmax, fres, ksa)
-                        fmax = fres
-                        if un <= 0.0:  # held only by the bond: it opens
-                            e_bond += spring_energy(fn, kna) + spring_energy(fmax, ksa)
-                            gone = True
-                    f = fmax / trial if trial > 0.0 else 0.0
-                    us0 *= f
-                    us1 *= f
-                    us2 *= f
-                if gone:
-                    us0 = us1 = us2 = fn = 0.0
-                s.slot_shear[p, j, 0] = us0
-                s.slot_shear[p, j, 1] = us1
-                s.slot_shear[p, j, 2] = us2
-                s.slot_normal_force[p, j] = fn
-                if gone:
-                    continue
-                elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
-                u_side += 0.5 * kn * full_area * un * un
-                active += 1
-                # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
-                # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
-                fdn = -beta * kna * vn
-                bs = 0.0 if slipping else beta * ksa
-                d0 = fdn * n0 - bs * vs0
-                d1 = fdn * n1 - bs * vs1
-                d2 = fdn * n2 - bs * vs2
-                sc.dashpot_force[k, 0] = d0
-                sc.dashpot_force[k, 1] = d1
-                sc.dashpot_force[k, 2] = d2
-                fs = ksa * ramp
-                _store(
-                    sc.contact_force, sc.contact_point, k,
-                    f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
-                    x0, x1, x2,
-                )
-            if side == 0:
-                u_owner = u_side
-            else:
-                u_target = u_side
-        if dlam != 0.0:
-            # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
-            g = (u_target - u_owner) * dlam
-            for c in range(3):
-                sc.blend_force_owner[i, c] *= g
-                sc.blend_force_target[i, c] *= g
+        # The owner's points on the target face, then (while the pair may blend) the target's on
+        # the owner face.
+        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel)
+        elastic += el
+        active += ac
+        e_fric += ef
+        e_bond += eb
+        if split < stop:
+            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel)
+            elastic += el
+            active += ac
+            e_fric += ef
+            e_bond += eb
+            if dlam != 0.0:
+                # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
+                g = (u_target - u_owner) * dlam
+                for c in range(3):
+                    sc.blend_force_owner[i, c] *= g
+                    sc.blend_force_target[i, c] *= g
     return elastic, active, e_fric, e_bond, nrel
+
+
+@njit(cache=True, _nrt=False)
+def _law_range(
+    m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
+    wgt: float, blending: bool, dt: float, nrel: int,
+) -> tuple[float, int, float, float, int, float]:
+    """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
+    pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
+    False: the whole pair, wgt 1). Returns (elastic energy, active count, friction and bond energy
+    dissipated, the new opened count, the normal spring energy at full share)."""
+    elastic = 0.0
+    active = 0
+    e_fric = 0.0
+    e_bond = 0.0
+    u_side = 0.0
+    fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+    go = m.block_group[o]
+    gt = m.block_group[t]
+    kn = m.mat_kn[go, gt]
+    ks = m.mat_ks[go, gt]
+    beta = m.mat_beta[go, gt]
+    n0, n1, n2 = fm.nx, fm.ny, fm.nz
+    for k in range(k0, k1):
+        code = s.track[k]
+        p = code // SLOTS
+        j = code - SLOTS * p
+        sc.dashpot_force[k, 0] = 0.0
+        sc.dashpot_force[k, 1] = 0.0
+        sc.dashpot_force[k, 2] = 0.0
+        sc.contact_force[k, 0] = 0.0
+        sc.contact_force[k, 1] = 0.0
+        sc.contact_force[k, 2] = 0.0
+        full_area = sc.track_area[k]
+        area = full_area
+        if blending:  # this side's share (kernels.blend); 0 switches it off
+            area *= wgt
+            sc.track_area[k] = area
+        yu = sc.track_point_u[k]
+        yw = sc.track_point_w[k]
+        un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + sc.track_depth_shift[k]
+        un_prev = s.slot_overlap[p, j]
+        s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
+        us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
+        bonded = s.slot_bonded[p, j]
+        prev_area = s.slot_area[p, j]
+        s.slot_area[p, j] = area
+        # Contact point: midway between the owner-plane point and the target plane.
+        x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
+        x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
+        x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
+        v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
+        vn = v0 * n0 + v1 * n1 + v2 * n2  # > 0: separating
+        vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+        kna = kn * area
+        ksa = ks * area
+        fn = kna * un
+        opened = area <= 0.0 or (un <= 0.0 and not bonded)
+        if not opened and bonded and fn < -m.mat_tension[go, gt] * area:
+            # Tension cut-off: the bond fails and the point opens.
+            e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+            s.slot_bonded[p, j] = False
+            s.point_failed[p] = FAILED_TENSION
+            opened = True
+            bonded = False
+            prev_area = 0.0  # its energy is counted
+        if opened:
+            # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
+            e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
+            if bonded:
+                e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
+                s.slot_bonded[p, j] = False
+                s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
+            elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
+                # Opened during the last step: its release is computed apart (release pass), its
+                # shear extension kept until then.
+                sc.pending[nrel] = k
+                sc.pending_pair[nrel] = i
+                sc.release_overlap[nrel] = un_prev
+                sc.release_area[nrel] = prev_area
+                nrel += 1
+                s.slot_normal_force[p, j] = 0.0
+                continue
+            else:
+                e_fric += e
+            s.slot_shear[p, j, 0] = 0.0
+            s.slot_shear[p, j, 1] = 0.0
+            s.slot_shear[p, j, 2] = 0.0
+            s.slot_normal_force[p, j] = 0.0
+            continue
+        # An unbonded contact that closed during the last step: its springs act since the crossing
+        # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
+        ramp = 1.0
+        since = dt
+        if not bonded and un_prev <= 0.0 and vn < 0.0:
+            since = min(un / (-vn * dt), 1.0) * dt
+            ramp = ramp_overlap(un, un_prev, vn, dt) / un
+        f_applied = fn * ramp
+        us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
+        trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+        if bonded:
+            fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
+        else:
+            fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
+        slipping = trial > fmax
+        gone = False
+        if slipping:
+            e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
+            if bonded:
+                # Shear failure: drop to the residual strength; the released energy is the bond's.
+                s.slot_bonded[p, j] = False
+                s.point_failed[p] = FAILED_SHEAR
+                fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
+                e_bond += drop_dissipation(fmax, fres, ksa)
+                fmax = fres
+                if un <= 0.0:  # held only by the bond: it opens
+                    e_bond += spring_energy(fn, kna) + spring_energy(fmax, ksa)
+                    gone = True
+            f = fmax / trial if trial > 0.0 else 0.0
+            us0 *= f
+            us1 *= f
+            us2 *= f
+        if gone:
+            us0 = us1 = us2 = fn = 0.0
+        s.slot_shear[p, j, 0] = us0
+        s.slot_shear[p, j, 1] = us1
+        s.slot_shear[p, j, 2] = us2
+        s.slot_normal_force[p, j] = fn
+        if gone:
+            continue
+        elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
+        if blending:
+            u_side += 0.5 * kn * full_area * un * un
+        active += 1
+        # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
+        # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
+        fdn = -beta * kna * vn
+        bs = 0.0 if slipping else beta * ksa
+        d0 = fdn * n0 - bs * vs0
+        d1 = fdn * n1 - bs * vs1
+        d2 = fdn * n2 - bs * vs2
+        sc.dashpot_force[k, 0] = d0
+        sc.dashpot_force[k, 1] = d1
+        sc.dashpot_force[k, 2] = d2
+        fs = ksa * ramp
+        _store(
+            sc.contact_force, sc.contact_point, k,
+            f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
+            x0, x1, x2,
+        )
+    return elastic, active, e_fric, e_bond, nrel, u_side
 
 
 @njit(cache=True, _nrt=False)
@@ -381,8 +400,8 @@ def _blend(m: ModelArrays, s: State, sc: Scratch, i: int, fa: int, fb: int, a: i
     (scaled by (U_t - U_o) lambda' once the spring energies are known) and asks for a detection
     when the target's points are needed but not tracked."""
     sc.pair_weight[i] = 0.0
-    if sc.pair_bonded[i]:
-        return 0.0, 0.0
+    if sc.pair_bonded[i] or s.pair_track_start[i] == s.pair_track_stop[i]:
+        return 0.0, 0.0  # a joint (flush) or nothing tracked: the detection tracks what comes near
     sep_o, v0, v1, v2, na0, na1, na2 = face_clearance(
         m.face_normal, m.face_offset, m.face_block, m.block_vertex_start, m.vertex_local, sc.rotation, s.position, fa, b
     )
