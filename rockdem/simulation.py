@@ -7,7 +7,10 @@ breaks or its state is no longer finite (diverged), or when a free block leaves 
 (it fell through its support or flew away); the result keeps the frames before it and says where
 (``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
 ``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
-``interrupted``.
+``interrupted``. With ``stop=`` (:mod:`rockdem.stopping`) the loop checks between chunks of a fixed
+number of steps whether the outcome is decided (collapsed, or at rest after the input) and ends
+there (``attrs["stop_reason"]``, ``stop_time``). :func:`run_model` is the loop without the Dataset
+(studies summarise its raw frames).
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from __future__ import annotations
 import math
 import time as _time
 import warnings
-from typing import Any, Mapping, Sequence
+from typing import Any, Mapping, NamedTuple, Sequence
 
 import numpy as np
 import xarray as xr
@@ -26,9 +29,10 @@ from .model import Model
 from .results import build_dataset
 from .snapshots import ContactSnapshots
 from .state import grow_buffers, initial_state
+from .stopping import Decision, Stopper, StopRule, stop_rule
 from .timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, TimestepInfo, stable_timestep
 
-__all__ = ["simulate", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
+__all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
 
 Monitor = tuple[int | str, Sequence[float]]
 """A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
@@ -52,6 +56,7 @@ def simulate(
     progress: bool | None = None,
     contact_interval: float | None = None,
     max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
 ) -> xr.Dataset:
     """Run ``model`` for ``duration`` seconds and return the recorded histories.
 
@@ -72,6 +77,10 @@ def simulate(
             default None: none recorded.
         max_steps: a run estimated to need more steps (duration / initial dt) is refused before it
             starts, with the estimate: an absurd stiffness, mass or damping would otherwise hang.
+        stop: end the run once its outcome is decided (:mod:`rockdem.stopping`): "off" (default),
+            "decided" (collapsed, or at rest after the input), "collapse" or "rest"; the result
+            then ends at that frame and says why and when (attrs ``stop_reason``, ``stop_time``,
+            ``stop_block``).
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
@@ -80,6 +89,70 @@ def simulate(
         TypeError: ``model`` is not a finalized Model.
         ValueError: bad options, a timestep longer than the run, or more steps than ``max_steps``.
     """
+    out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
+                    record_interval=record_interval, monitors=monitors, progress=progress,
+                    contact_interval=contact_interval, max_steps=max_steps, stop=stop)
+    ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
+    return out.snapshots.attach(ds)
+
+
+class Start(NamedTuple):
+    """What a run starts from: the timestep (:func:`rockdem.timestep.stable_timestep`) and the
+    initial state and scratch arrays (:func:`rockdem.state.initial_state`). They depend on the
+    model's geometry, materials, damping and initial pose, not on its prescribed inputs (ground
+    motion, body acceleration), so the runs of a study that only change the record reuse them."""
+
+    timestep: TimestepInfo
+    state: Any
+    scratch: Any
+
+    def copy(self) -> Start:
+        """An independent copy (every array of the state and scratch tuples copied, field by field)."""
+        def dup(nt: Any) -> Any:
+            return type(nt)(*(a.copy() if isinstance(a, np.ndarray) else a for a in nt))
+
+        return Start(self.timestep, dup(self.state), dup(self.scratch))
+
+
+def prepare_start(model: Model, *, timestep_rule: str = "bound", safety: float = DEFAULT_SAFETY,
+                  resolution: float = DEFAULT_RESOLUTION, dt: float | None = None) -> Start:
+    """The :class:`Start` of a run of ``model`` with these timestep options."""
+    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    return Start(info, *initial_state(model))
+
+
+class RunOutput(NamedTuple):
+    """What :func:`run_model` returns: the recorded frames (Records trimmed to the frames computed),
+    the result's attributes, the checked monitors (name -> (block id, reference point [m])) and the
+    contact snapshots."""
+
+    records: Records
+    attrs: dict[str, Any]
+    monitors: dict[str, tuple[int, np.ndarray]]
+    snapshots: ContactSnapshots
+
+
+def run_model(
+    model: Model,
+    duration: float,
+    *,
+    dt: float | None = None,
+    timestep_rule: str = "bound",
+    safety: float = DEFAULT_SAFETY,
+    resolution: float = DEFAULT_RESOLUTION,
+    record_interval: float = 0.002,
+    monitors: Mapping[str, Monitor] | None = None,
+    progress: bool | None = None,
+    contact_interval: float | None = None,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
+    start: Start | None = None,
+) -> RunOutput:
+    """:func:`simulate` without building the Dataset: the raw recorded frames and attributes
+    (studies summarise these directly; same arguments). ``attrs["kernel_s"]`` is the time spent
+    inside the compiled kernel [s], ``runtime_s`` the whole loop's. ``start``: the timestep and
+    initial state of :func:`prepare_start` for this model and these options (a copy, see
+    :meth:`Start.copy`; the run mutates it), computed here when None."""
     if not isinstance(model, Model):
         hint = " (call builder.finalize() first)" if type(model).__name__ == "ModelBuilder" else ""
         raise TypeError(f"simulate: model must be a rockdem Model{hint}, got {type(model).__name__}")
@@ -88,8 +161,11 @@ def simulate(
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
         raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
     mon = _check_monitors(model, monitors or {})
+    rule = stop_rule(stop)
     snaps = ContactSnapshots(model, contact_interval)
-    info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    if start is None:
+        start = prepare_start(model, timestep_rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    info = start.timestep
     _check_step_count(info, duration, max_steps)
     frames = int(math.floor(duration / record_interval + 1e-9)) + 1
     need = frames * model.block_count * 13 * 8
@@ -99,7 +175,7 @@ def simulate(
             f"raise record_interval (now {record_interval} s)"
         )
     wall0 = _time.perf_counter()
-    state, scratch = initial_state(model)
+    state, scratch = start.state, start.scratch
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
@@ -112,15 +188,21 @@ def simulate(
     sunk: tuple[str, str] | None = None
     thickness = _block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
+    stopper = Stopper(model, rule, record_interval) if rule is not None else None
+    decision: Decision | None = None
+    kernel = 0.0
     bar = None
     interrupted = False
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
         while state.time[0] < t_end and frame < frames:
-            stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
+            if stopper is not None:  # a fixed number of steps between checks (see CHECK_STEPS)
+                chunk = stopper.rule.check_steps * float(state.dt[0])
+            t_stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
             t0 = _time.perf_counter()
-            frame, status = advance(m, state, scratch, stop, record_interval, rec, frame)
+            frame, status = advance(m, state, scratch, t_stop, record_interval, rec, frame)
             elapsed = _time.perf_counter() - t0
+            kernel += elapsed
             if status == STATUS_GROW:
                 state, scratch = grow_buffers(state, scratch)
                 continue
@@ -130,7 +212,13 @@ def simulate(
             if sunk is not None:
                 break
             snaps.take(state)
-            chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+            if stopper is not None:
+                decision = stopper.check(rec, frame)
+                if decision is not None:
+                    frame = decision.frame + 1  # the result ends at the decided frame
+                    break
+            else:
+                chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
                 bar = _progress_bar(duration)
             if bar is not None:
@@ -151,10 +239,14 @@ def simulate(
         "timestep_rule": info.rule,
         "steps": int(state.step[0]),
         "runtime_s": runtime,
+        "kernel_s": kernel,
         "duration": duration,
         "record_interval": record_interval,
         "interrupted": int(interrupted),
+        "stop_rule": rule.mode if rule is not None else "off",
     }
+    if decision is not None:
+        attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
     if status in (STATUS_DIVERGED, STATUS_LOST):
         attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
         warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
@@ -177,8 +269,7 @@ def simulate(
             RuntimeWarning, stacklevel=2,
         )
     rec = Records(*(a[:frame] for a in rec))
-    ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
-    return snaps.attach(ds)
+    return RunOutput(rec, attrs, mon, snaps)
 
 
 SINK_FRACTION = 0.25
