@@ -67,11 +67,14 @@ STOP_MODES = ("off", "decided", "collapse", "rest")
 """``off``: run to the end; ``decided``: stop on collapse or at rest after the input; ``collapse``
 or ``rest`` alone."""
 
-CHECK_STEPS = 4000
-"""Steps per compiled chunk while a stop rule is active. A chunk boundary costs about 16 us for the
-call into the kernel plus the checks (about 30 us); 4000 steps take 2.5 ms on the 0.2 x 2 m block
-(0.6 us per step), so the checks cost ~2 % and a decided run computes at most 2.5 ms too many
-(measured, ``benchmarks/bench_ida.py --chunks``)."""
+CHECK_STEPS = 1000
+"""Steps per compiled chunk while a stop rule is active. A chunk boundary costs about 20 us of
+processor time (the call into the kernel, the engine's own checks and the stop checks); a step of
+the 0.2 x 2 m block costs 0.6-0.7 us, so the checks cost ~3 % and a decided run computes at most
+0.7 ms too much. Measured on 100 IDA runs of that block (``benchmarks/bench_ida.py --chunks``,
+processor time per run): 250 steps 40.1 ms, 1000 steps 34.1 ms, 4000 steps 38.6 ms, 16000 steps
+108 ms (the steps after the decision, on a block lying on its side, dominate), with the same
+decisions at every interval (they are made per recorded frame)."""
 
 REST_WINDOW = 0.5
 """Time over which a block must stay still to be at rest [s] (at least 5 recorded frames)."""

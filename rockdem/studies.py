@@ -299,7 +299,13 @@ class Store:
 
     def append(self, row: Mapping[str, Any]) -> None:
         """Append one row and make it durable (flush + fsync)."""
-        line = json.dumps(row, separators=(",", ":"), default=_json_default) + "\n"
+        self.extend([row])
+
+    def extend(self, rows: Sequence[Mapping[str, Any]]) -> None:
+        """Append rows (one line each, in one write) and make them durable (flush + fsync)."""
+        if not rows:
+            return
+        line = "".join(json.dumps(row, separators=(",", ":"), default=_json_default) + "\n" for row in rows)
         # a previous interrupted write may have left a partial line: start on a fresh line
         if self.path.exists() and self.path.stat().st_size > 0:
             with self.path.open("rb") as fh:
@@ -486,11 +492,11 @@ def execute(
             it = _iter_dask(todo, scheduler, fn, batch)
         try:
             for rows in it:
+                if st is not None:
+                    st.extend(rows)  # a task's rows arrive together: one write, one fsync
                 for row in rows:
-                    if st is not None:
-                        st.append(row)
                     results[row["id"]] = row
-                    bar.update(1)
+                bar.update(len(rows))
         finally:
             close = getattr(it, "close", None)
             if close is not None:
