@@ -19,6 +19,7 @@ arrays), so a spec's row is identical, bit for bit (timings aside), whichever pa
 from __future__ import annotations
 
 import json
+import threading
 import time
 import warnings
 from collections import OrderedDict
@@ -38,6 +39,7 @@ TEMPLATE_CACHE = 16
 """Case templates (distinct specimens) kept per process."""
 
 _TEMPLATES: OrderedDict[str, CaseTemplate] = OrderedDict()
+_LOCK = threading.Lock()  # Dask workers may run several tasks in threads
 
 
 class Frames(NamedTuple):
@@ -75,7 +77,8 @@ def frames_from_dataset(ds: Any) -> Frames:
     return Frames(
         np.asarray(ds.time.values, dtype=float), ds.rocking_angle.values, ds.block_position.values,
         ds.block_quaternion.values, ds.monitor_displacement.values, int(ds.contacts_failed_shear.values[-1]),
-        int(ds.contacts_failed_tension.values[-1]), np.asarray(ds.block_free.values, dtype=bool), ds.block_eta.values,
+        int(ds.contacts_failed_tension.values[-1]), np.asarray(ds.block_free.values, dtype=bool),
+        ds.block_eta.values if "block_eta" in ds else np.full(ds.sizes["block"], np.nan),
         ds.vertex_local.values, ds.block_vertex_start.values, dict(ds.attrs),
     )
 
@@ -177,15 +180,18 @@ def _history(spec: Any, t: np.ndarray, theta: np.ndarray, monitor: np.ndarray, a
 def case_of(data: Mapping[str, Any]) -> Case:
     """The case of a case dict, through this process's template cache (see the module notes)."""
     key = template_key(data)
-    tpl = _TEMPLATES.get(key)
-    if tpl is None:
-        tpl = CaseTemplate(data)
+    with _LOCK:
+        tpl = _TEMPLATES.get(key)
+        if tpl is not None:
+            _TEMPLATES.move_to_end(key)
+    if tpl is not None:
+        return tpl.derive(data)
+    tpl = CaseTemplate(data)
+    with _LOCK:
         _TEMPLATES[key] = tpl
         while len(_TEMPLATES) > TEMPLATE_CACHE:
             _TEMPLATES.popitem(last=False)
-        return tpl.case
-    _TEMPLATES.move_to_end(key)
-    return tpl.derive(data)
+    return tpl.case
 
 
 _STARTS: OrderedDict[str, Any] = OrderedDict()
@@ -199,14 +205,16 @@ def _start(data: Mapping[str, Any], case: Case) -> Any:
     r = case.run
     key = json.dumps([template_key(data), case.model.damping.__dict__, r.timestep_rule, r.safety, r.resolution, r.dt],
                      sort_keys=True, default=str)
-    start = _STARTS.get(key)
+    with _LOCK:
+        start = _STARTS.get(key)
+        if start is not None:
+            _STARTS.move_to_end(key)
     if start is None:
-        start = _STARTS[key] = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety,
-                                             resolution=r.resolution, dt=r.dt)
-        while len(_STARTS) > TEMPLATE_CACHE:
-            _STARTS.popitem(last=False)
-    else:
-        _STARTS.move_to_end(key)
+        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution, dt=r.dt)
+        with _LOCK:
+            _STARTS[key] = start
+            while len(_STARTS) > TEMPLATE_CACHE:
+                _STARTS.popitem(last=False)
     return start.copy()
 
 

@@ -571,7 +571,8 @@ class CaseTemplate:
         run = _run_options(top)
         damping = _damping(top)
         builder, monitors = _specimen(top)
-        self._swap = top.data.get("loading", {}).get("type") in SWAPPABLE_LOADINGS if isinstance(top.data.get("loading", {}), Mapping) else False
+        load = top.data.get("loading", {})
+        self._swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
         self._bare = copy.copy(builder) if self._swap else None  # before the loading
         self._monitors = dict(monitors)
         ctx = _loading(top, builder, monitors, run)

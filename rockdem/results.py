@@ -52,6 +52,7 @@ from .model import Model
 __all__ = [
     "build_dataset",
     "block_eta",
+    "block_thickness",
     "Pivot",
     "rocking_pivots",
     "ground_blocks",
@@ -252,6 +253,13 @@ def _base(model: Model, b: int) -> tuple[float, float, float] | None:
     size = float(np.ptp(v, axis=0).max())
     base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
     return -float(z.min()), float(np.max(base @ d)), -float(np.min(base @ d))
+
+
+def block_thickness(model: Model) -> np.ndarray:
+    """(nb,) smallest extent of each block along its principal axes [m]."""
+    m = model.arrays
+    v, start = m.vertex_local, m.block_vertex_start
+    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
 def block_eta(model: Model) -> np.ndarray:

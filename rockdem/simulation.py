@@ -26,7 +26,7 @@ import xarray as xr
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
-from .results import build_dataset
+from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
 from .state import grow_buffers, initial_state
 from .stopping import Decision, Stopper, StopRule, stop_rule
@@ -186,7 +186,7 @@ def run_model(
     frame = 0
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
-    thickness = _block_thickness(model)
+    thickness = block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
     stopper = Stopper(model, rule, record_interval) if rule is not None else None
     decision: Decision | None = None
@@ -275,13 +275,6 @@ def run_model(
 SINK_FRACTION = 0.25
 """A run stops when a sub-contact's overlap exceeds this fraction of the thinner of its two blocks:
 the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
-
-
-def _block_thickness(model: Model) -> np.ndarray:
-    """(nb,) smallest extent of each block along its principal axes [m]."""
-    m = model.arrays
-    v, start = m.vertex_local, m.block_vertex_start
-    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
 def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | None:

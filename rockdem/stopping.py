@@ -46,7 +46,7 @@ import numpy as np
 
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
-from .results import ground_blocks, rocking_pivots
+from .results import block_thickness, ground_blocks, rocking_pivots
 
 __all__ = [
     "STOP_MODES",
@@ -208,8 +208,6 @@ class Stopper:
     """
 
     def __init__(self, model: Model, rule: StopRule, record_interval: float) -> None:
-        from .simulation import _block_thickness
-
         m = model.arrays
         self.model, self.rule = model, rule
         self.free = np.flatnonzero(m.block_free)
@@ -217,7 +215,7 @@ class Stopper:
         self.ground = int(ground[0]) if ground.size else -1
         self.g = float(np.linalg.norm(m.gravity))
         self.up = _up(model)
-        self.thickness = _block_thickness(model)
+        self.thickness = block_thickness(model)
         self.radius = np.asarray(m.block_radius, dtype=float)
         self.window = max(REST_WINDOW, 5.0 * record_interval)
         self.t_input = input_end_time(model)
@@ -235,7 +233,8 @@ class Stopper:
         pivots = rocking_pivots(self.model, b)
         if pivots is None:
             return None
-        return {"block": b, "mass": pivots[0].mass, "sides": [(p.eta, p.radius, p.inertia) for p in pivots],
+        return {"block": b, "mass": pivots[0].mass, "eta": np.array([p.eta for p in pivots]),
+                "radius": np.array([p.radius for p in pivots]), "inertia": np.array([p.inertia for p in pivots]),
                 "quat_ref": quats_to_matrices(self.model.quaternion_ref[b]), "axis": self.model.rocking_axis,
                 "q_ref": np.asarray(self.model.quaternion_ref[b], dtype=float), "eta_min": min(p.eta for p in pivots)}
 
@@ -268,8 +267,8 @@ class Stopper:
         t = rec.time[lo:hi]
         rel = quats_to_matrices(rec.quaternion[lo:hi, b]) @ p["quat_ref"].T
         theta = rotation_vector(rel) @ p["axis"]
-        side = np.where(theta >= 0.0, 0, 1)
-        eta, r, i_o = (np.array([sd[j] for sd in p["sides"]])[side] for j in range(3))
+        side = np.where(theta >= 0.0, 0, 1)  # the edge toward +d for theta > 0, else toward -d
+        eta, r, i_o = p["eta"][side], p["radius"][side], p["inertia"][side]
         phi = np.abs(theta) - eta
         k = np.clip(np.searchsorted(self.acc_time, t, side="right") - 1, 0, None)
         a_h, a_v = self.acc_h_after[k], self.acc_v_after[k]

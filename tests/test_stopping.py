@@ -186,3 +186,17 @@ def test_a_falling_block_of_an_assembly_stops_the_run():
     b = list(ds.block_name.values).index(a["stop_block"])
     thickness = 0.19  # the smaller dimension of both blocks
     assert float(ds.block_position.values[0, b, 2] - ds.block_position.values[-1, b, 2]) > 0.5 * thickness
+
+
+def test_studies_stop_by_default_and_keep_their_ids_when_off():
+    """Study files and make_specs add run.stop = "decided" unless told otherwise; with stop = "off"
+    nothing is added, so a study's runs keep the ids (and stored rows) they had before stopping."""
+    from rockdem.studies import RunSpec, parse_study
+
+    study = {"base": "free-rocking", "duration": 1.0, "grid": {"damping.alpha": [1.0]}}
+    on = parse_study({"study": study}).specs[0]
+    assert dict(on.overrides)["run.stop"] == "decided"
+    off = parse_study({"study": {**study, "stop": "off"}}).specs[0]
+    assert off.id == RunSpec.make(example_case("free-rocking"), {"damping.alpha": 1.0}, duration=1.0).id
+    with pytest.raises(ValueError, match=r"\[study\] stop must be one of"):
+        parse_study({"study": {**study, "stop": "maybe"}})
