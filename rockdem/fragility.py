@@ -347,7 +347,7 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     ax.set_xscale("log")
     ax.set_xlim(ROTATION_FLOOR * 0.8, 1.5 * x_max)
     ax.set_xlabel("peak rotation / eta [-] (survivals; dotted: each record's collapse capacity)")
-    ax.set_ylabel(IM_COLUMNS.get(im, im))
+    ax.set_ylabel(_im_label(table, im))
     ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=7, loc="upper left", ncol=1 if len(recs) < 8 else 2)
     strip.set_xticks(range(len(recs)))
@@ -362,6 +362,13 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     p = save_figure(fig, path)
     plt.close(fig)
     return p
+
+
+def _im_label(table: pd.DataFrame | None, im: str) -> str:
+    """Axis label of an IM column (Sa with its period)."""
+    if im == "sa_g" and table is not None and "sa_period_s" in table and table["sa_period_s"].notna().any():
+        return f"Sa(T = {float(table['sa_period_s'].dropna().iloc[0]):.3g} s) [g], 5 % damping"
+    return IM_COLUMNS.get(im, im)
 
 
 def _observed(table: pd.DataFrame, im: str, bins: int = 12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -402,7 +409,7 @@ def _fragility_axes(ax: Any, frag: Fragility | None, table: pd.DataFrame | None,
         ax.plot(xs, frag.probability(xs), color="C0", label=f"theta = {frag.theta:.3g}, beta = {frag.beta:.3g}")
     else:
         ax.text(0.5, 0.5, "not fitted\n(no failures or no survivals)", transform=ax.transAxes, ha="center", fontsize=8)
-    ax.set_xlabel(IM_COLUMNS.get(im, im))
+    ax.set_xlabel(_im_label(table, im))
     ax.set_ylabel("P(failure)")
     ax.set_ylim(-0.02, 1.02)
     ax.set_xlim(0.0, hi)

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 
@@ -119,4 +117,3 @@ def test_start_is_copied_not_shared(base):
     assert copy.timestep == start.timestep
     for a, b in zip(copy.state + copy.scratch, start.state + start.scratch):
         assert a is not b and np.array_equal(a, b)
-    assert dataclasses.is_dataclass(case.run)
