@@ -396,9 +396,10 @@ def _iter_dask(todo: Sequence[RunSpec], scheduler: Any, fn: Callable[[list[RunSp
             client.close()
 
 
-MAX_TASK_RUNS = 32
+MAX_TASK_RUNS = 16
 """Most runs per task of the process pool or Dask (the batch path): a task's rows reach the store
-when the whole task is done, so a task stays a few seconds of work."""
+when the whole task is done, so a killed sweep recomputes at most this many runs per worker (half
+a second of work for the IDA block of ``benchmarks/bench_ida.py``); a task costs ~1 ms to send."""
 
 TASKS_PER_WORKER = 4
 """Tasks per worker at least, when there are enough runs (balances runs of unequal length)."""

@@ -7,7 +7,7 @@ import pytest
 
 from rockdem.batch import batch_row, frames_from_dataset, run_batch, summary_row
 from rockdem.case import CaseTemplate, apply_overrides, example_case, load_case, parse_case, template_key
-from rockdem.studies import TIMING_COLUMNS, RunSpec, _tasks, run_spec
+from rockdem.studies import MAX_TASK_RUNS, TIMING_COLUMNS, RunSpec, _tasks, run_spec
 
 SMALL = {"run.record_interval": 0.01, "specimen.height": 0.5, "specimen.width": 0.19}
 
@@ -102,7 +102,7 @@ def test_tasks_keep_a_specimen_together(base):
     tasks = _tasks(other[:1] + ida + other[1:], 2, batch=True)
     assert sorted(s.id for t in tasks for s in t) == sorted(s.id for s in other + ida)
     for t in tasks:
-        assert len({template_key(s.case_dict()) for s in t}) == 1 and len(t) <= 32
+        assert len({template_key(s.case_dict()) for s in t}) == 1 and len(t) <= MAX_TASK_RUNS
     assert len(tasks) >= 2 * 4  # at least TASKS_PER_WORKER tasks per worker
     assert [len(t) for t in _tasks(ida, 2, batch=False)] == [1] * len(ida)
 
