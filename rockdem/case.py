@@ -223,10 +223,11 @@ class RunOptions:
     resolution: float = 0.3
     record_interval: float = 0.002
     contact_tolerance: float | None = None
+    contact_interval: float | None = None
     stop: str = "off"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Case:
     """A built case: the model, run options, monitors and output settings, plus what the loading
     adds to the result: ``attrs`` (scalars, e.g. the pushover ramp, the record and its PGA, the tilt
@@ -240,6 +241,17 @@ class Case:
     data: dict[str, Any]
     attrs: dict[str, Any] = field(default_factory=dict)
     series: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        model = repr(self.model).split("\n", 1)[1]
+        return f"rockdem Case {self.name!r}: {run}, monitors {sorted(self.monitors)}\n{model}"
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        return f"<b>rockdem Case {escape(self.name)}</b>: {escape(run)}<br>{self.model._repr_html_()}"
 
 
 SpecimenBuilder = Callable[[Table, ModelBuilder], dict[str, Monitor]]
@@ -472,6 +484,7 @@ def _run_options(top: Table) -> RunOptions:
         resolution=run_t.number("resolution", 0.3, positive=True),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
+        contact_interval=run_t.optional_number("contact_interval", positive=True),
         stop=run_t.string("stop", "off", choices=STOP_MODES),
     )
     run_t.finish()
@@ -519,6 +532,9 @@ def _output(top: Table) -> dict[str, Any]:
         "directory": out_t.string("directory", ""),
         "plot": out_t.boolean("plot", True),
         "csv": out_t.boolean("csv", True),
+        "checkpoint": out_t.boolean("checkpoint", True),
+        "checkpoint_every": out_t.optional_number("checkpoint_every", positive=True),
+        "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
     return output

@@ -135,9 +135,10 @@ class _Block:
     reference: Polyhedron | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Model:
-    """A frozen model: the kernel arrays plus the names and initial state.
+    """A frozen model: the kernel arrays plus the names and initial state (printed as a short
+    summary; a notebook shows it as a table).
 
     Attributes:
         arrays: flat arrays used by the kernels.
@@ -192,6 +193,55 @@ class Model:
                 raise ValueError("with_inputs: the builder's blocks are not this model's")
             fields.update(builder.input_arrays())
         return replace(self, arrays=self.arrays._replace(**fields), damping=damping if damping is not None else self.damping)
+
+    def summary(self) -> dict[str, str]:
+        """Short description, label -> text: blocks, points, groups, joints, damping, loading, size."""
+        m = self.arrays
+        free = m.block_free.astype(bool)
+        driven = [n for n, f in zip(self.block_names, free) if not f]
+        v = self.arrays.vertex_local
+        owner = np.repeat(np.arange(self.block_count), np.diff(m.block_vertex_start))
+        from .kernels.rotation import quats_to_matrices
+
+        world = np.einsum("vij,vj->vi", quats_to_matrices(self.quaternion0)[owner], v) + self.position0[owner]
+        lo, hi = world[free[owner]].min(axis=0), world[free[owner]].max(axis=0)
+        tiny = 1e-9 * max(float(np.max(hi - lo)), 1e-300)
+        lo, hi = np.where(np.abs(lo) < tiny, 0.0, lo), np.where(np.abs(hi) < tiny, 0.0, hi)
+        kn = sorted({f"{mat.kn:.3g}" for mat in self.materials.values()})
+        phi = sorted({f"{math.degrees(math.atan(mat.tan_friction)):.3g}" for mat in self.materials.values()})
+        loading = []
+        if m.ground_motion >= 0:
+            loading.append(f"ground motion ({m.motion_time[-1]:.3g} s)" if m.motion_time.size else "ground motion")
+        if m.body_time.size:
+            loading.append(f"body acceleration ({m.body_time[-1]:.3g} s)")
+        if np.any(m.block_motion[~free] > (0 if m.ground_motion >= 0 else -1)):
+            loading.append("prescribed motion of driven blocks")
+        tilted = int(np.count_nonzero(np.any(self.quaternion0 != self.quaternion_ref, axis=1)))
+        if tilted:
+            loading.append(f"{tilted} block(s) tilted")
+        d = self.damping
+        return {
+            "blocks": f"{self.block_count} ({int(free.sum())} free, {len(driven)} driven: {_short_list(driven)})",
+            "free blocks": _short_list([n for n, f in zip(self.block_names, free) if f]),
+            "free mass": f"{float(m.block_mass[free].sum()):.4g} kg",
+            "free blocks span": "  ".join(f"{a} {lo[i]:.3g}..{hi[i]:.3g}" for i, a in enumerate("xyz")) + " m",
+            "interface points": f"{self.point_count}",
+            "groups": ", ".join(self.group_names),
+            "joints": f"kn {'/'.join(kn)} Pa/m, friction {'/'.join(phi)} deg",
+            "damping": f"alpha {d.alpha:g} 1/s, beta {d.beta:g} s" + (f", local {d.local:g}" if d.local else ""),
+            "loading": ", ".join(loading) or "gravity only",
+        }
+
+    def __repr__(self) -> str:
+        rows = self.summary()
+        return "rockdem Model\n" + "\n".join(f"  {k:<17} {v}" for k, v in rows.items())
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        rows = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}</td></tr>"
+                       for k, v in self.summary().items())
+        return f"<b>rockdem Model</b><table>{rows}</table>"
 
     def block_id(self, name: str) -> int:
         """Index of the block called ``name``."""
@@ -644,6 +694,13 @@ def damping_arrays(materials: Mapping[tuple[str, str], JointMaterial], group_nam
         "alpha_relative": bool(damping.alpha_relative),
         "local_damping": float(damping.local),
     }
+
+
+def _short_list(names: Sequence[str], n: int = 6) -> str:
+    """The first ``n`` names, comma-separated, with the count of the rest."""
+    names = list(names)
+    more = f", ... ({len(names) - n} more)" if len(names) > n else ""
+    return ", ".join(names[:n]) + more if names else "none"
 
 
 MAX_MOTION_SAMPLES = 10_000_000

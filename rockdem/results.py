@@ -1,5 +1,11 @@
 """Results as an xarray Dataset: building, saving to NetCDF, CSV export, loading.
 
+Coordinates: ``time`` [s]; ``block``: the block names, so that ``ds.sel(block="wall")`` selects a
+block by name; ``block_id`` (block): the integer ids, indexed too: ``ds.sel(block_id=1)`` or
+``ds.isel(block=1)`` (the id is the position); ``monitor`` and ``driven_block`` names. Results
+written before the names became the coordinate hold the ids in ``block`` (positional access with
+``.values[:, b]`` and ``isel`` works for both).
+
 Variables (dims; units in each variable's ``units`` attribute):
   block_position (time, block, xyz) [m]        centroid
   block_quaternion (time, block, quat)         body principal frame -> world (w, x, y, z)
@@ -40,10 +46,13 @@ from __future__ import annotations
 import os
 import uuid
 from pathlib import Path
-from typing import Mapping, NamedTuple
+from typing import TYPE_CHECKING, Mapping, NamedTuple
 
 import numpy as np
 import xarray as xr
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
@@ -63,6 +72,9 @@ __all__ = [
     "save",
     "load",
     "export_csv",
+    "contact_table",
+    "write_contact_table",
+    "with_block_index",
 ]
 
 _DISSIPATED = (
@@ -85,7 +97,9 @@ def build_dataset(
     t = rec.time
     rel_ref, rotvec = reference_rotations(model, rec.quaternion)
     axis = model.rocking_axis
-    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": np.arange(model.block_count)})
+    names = np.array(model.block_names, dtype=object)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": ("block", names, {"note": "block name"})})
+    ds = with_block_index(ds.assign_coords(block_id=("block", np.arange(model.block_count), {"note": "block id"})))
     xyz = ("time", "block", "xyz")
     ds["block_position"] = (xyz, rec.position, {"units": "m"})
     ds["block_quaternion"] = (("time", "block", "quat"), rec.quaternion, {"units": "1"})
@@ -330,8 +344,8 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out = ds.copy()
     for name in ("block_group", "block_name"):
         out[name] = out[name].astype(str)
-    for coord in ("monitor", "driven_block"):
-        if coord in out.coords:
+    for coord in ("block", "monitor", "driven_block"):
+        if coord in out.coords and out[coord].dtype == object:
             out = out.assign_coords({coord: out[coord].astype(str)})
     out["block_free"] = out["block_free"].astype(np.int8)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
@@ -351,6 +365,14 @@ def load(path: str | Path) -> xr.Dataset:
         raise FileNotFoundError(f"no result file at {p}")
     ds = xr.load_dataset(p)
     ds["block_free"] = ds["block_free"].astype(bool)
+    return with_block_index(ds)
+
+
+def with_block_index(ds: xr.Dataset) -> xr.Dataset:
+    """Index the ``block_id`` coordinate (if any) so that ``ds.sel(block_id=1)`` selects by id, as
+    ``ds.sel(block="wall")`` does by name (an index is not stored in NetCDF: :func:`load` adds it)."""
+    if "block_id" in ds.coords and "block_id" not in ds.xindexes:
+        ds = ds.set_xindex("block_id")
     return ds
 
 
@@ -388,3 +410,113 @@ def export_csv(ds: xr.Dataset, path: str | Path) -> Path:
     p.parent.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(cols).to_csv(p, index=False)
     return p
+
+
+def contact_table(ds: xr.Dataset) -> "pd.DataFrame":
+    """The contact snapshots of a result (run with ``contact_interval``) as one long table: a row per
+    snapshot and sub-contact (interface point with a partner block).
+
+    Columns: time [s], point, block, partner (names), x, y, z [m] (world), nx, ny, nz (unit normal of
+    the partner face, into ``block``), normal_force [N] (elastic, compression > 0), shear_force [N]
+    (magnitude), fnx, fny, fnz and fsx, fsy, fsz [N] (the elastic normal and shear force vectors on
+    ``block``, world), bonded (bool), failed (0 intact, 1 tension, 2 shear), area [m^2] (tributary).
+
+    Raises:
+        ValueError: the result has no contact snapshots.
+    """
+    import pandas as pd
+
+    if "contact_time" not in ds.coords:
+        raise ValueError("the result has no contact snapshots: run it with contact_interval "
+                         "([run] contact_interval = 0.05 in the case file, or --set run.contact_interval=0.05)")
+    partner = ds.point_partner.values
+    snap, point = np.nonzero(partner >= 0)
+    names = np.asarray(ds.block_name.values, dtype=object)
+    fn = ds.point_normal_force.values[snap, point]
+    normal = ds.point_normal.values[snap, point] if "point_normal" in ds else np.full((snap.size, 3), np.nan)
+    fs = (ds.point_shear_force_vector.values[snap, point] if "point_shear_force_vector" in ds
+          else np.full((snap.size, 3), np.nan))
+    pos = ds.point_position.values[snap, point]
+    cols: dict[str, np.ndarray] = {
+        "time": ds.contact_time.values[snap],
+        "point": point,
+        "block": names[ds.point_block.values[point]],
+        "partner": names[partner[snap, point]],
+        "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
+        "nx": normal[:, 0], "ny": normal[:, 1], "nz": normal[:, 2],
+        "normal_force": fn,
+        "shear_force": ds.point_shear_force.values[snap, point],
+        "fnx": fn * normal[:, 0], "fny": fn * normal[:, 1], "fnz": fn * normal[:, 2],
+        "fsx": fs[:, 0], "fsy": fs[:, 1], "fsz": fs[:, 2],
+        "bonded": ds.point_bonded.values[snap, point] > 0,
+        "failed": ds.point_failed.values[snap, point].astype(np.int8),
+        "area": ds.point_area.values[point],
+    }
+    return pd.DataFrame(cols)
+
+
+def _has_pyarrow() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("pyarrow") is not None
+
+
+def write_contact_table(ds: xr.Dataset, path: str | Path, fmt: str = "auto") -> Path:
+    """Write :func:`contact_table` as CSV or Parquet; returns the path written.
+
+    Args:
+        path: the file; with ``fmt="auto"`` and no .csv/.parquet suffix, the suffix is chosen:
+            .parquet when pyarrow is installed, else .csv.
+        fmt: "auto" (by suffix, as above), "csv" or "parquet" (needs pyarrow).
+    """
+    p = Path(path)
+    if fmt not in ("auto", "csv", "parquet"):
+        raise ValueError(f"contact table format must be 'auto', 'csv' or 'parquet', got {fmt!r}")
+    if fmt == "auto":
+        fmt = p.suffix.lower().lstrip(".") if p.suffix.lower() in (".csv", ".parquet") else (
+            "parquet" if _has_pyarrow() else "csv")
+    if fmt == "parquet" and not _has_pyarrow():
+        raise ValueError(f"{p}: Parquet needs pyarrow (pip install pyarrow); write a .csv instead")
+    if p.suffix.lower() != f".{fmt}":
+        p = p.with_name(p.name + f".{fmt}") if p.suffix.lower() not in (".csv", ".parquet") else p.with_suffix(f".{fmt}")
+    table = contact_table(ds)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "parquet":
+        table.to_parquet(p, index=False)
+    else:
+        table.to_csv(p, index=False)
+    return p
+
+
+@xr.register_dataset_accessor("rockdem")
+class ResultSummary:
+    """``ds.rockdem``: a short summary of a rockdem result (the run's summary table: steps,
+    timestep, peaks, energy balance, failed sub-contacts, rocking analysis), shown as text by
+    ``print(ds.rockdem)`` and as a table in a notebook; ``ds.rockdem.plot(kind)`` draws one of
+    :data:`rockdem.plots.PLOTS`."""
+
+    def __init__(self, ds: xr.Dataset) -> None:
+        self._ds = ds
+
+    def lines(self) -> list[str]:
+        """The summary rows (as printed by ``rockdem run``)."""
+        from .run_cli import summary_lines
+
+        return summary_lines(self._ds)
+
+    def __repr__(self) -> str:
+        name = self._ds.attrs.get("name", "")
+        return f"rockdem result{' ' + str(name) if name else ''}\n" + "\n".join("  " + line for line in self.lines())
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        return "<b>rockdem result</b><pre>" + escape("\n".join(self.lines())) + "</pre>"
+
+    def plot(self, kind: str = "history", **options: object) -> object:
+        """A figure of :data:`rockdem.plots.PLOTS` (``"history"``, ``"energy"``, ...), shown inline."""
+        from .plots import PLOTS
+
+        if kind not in PLOTS:
+            raise ValueError(f"plot kind {kind!r} unknown; use one of {sorted(PLOTS)}")
+        return PLOTS[kind](self._ds, **options)

@@ -218,6 +218,10 @@ class Stopper:
         self.thickness = block_thickness(model)
         self.radius = np.asarray(m.block_radius, dtype=float)
         self.window = max(REST_WINDOW, 5.0 * record_interval)
+        # frames in a rest window, fixed (not counted back from the last frame recorded, whose time
+        # lies within half a step of its nominal time): a frame's verdict must not depend on where
+        # the chunks end, so that continued runs decide as uninterrupted ones do
+        self.window_frames = int(math.floor(self.window / record_interval + 1e-9)) + 1
         self.t_input = input_end_time(model)
         t, h, v = _input_accelerations(model)
         self.acc_time = t
@@ -302,9 +306,8 @@ class Stopper:
     def _rest(self, rec: Any, lo: int, hi: int) -> Decision | None:
         """First frame k in lo..hi-1 whose window (the frames of the last ``window`` seconds up
         to k, all after the input's end) is at rest."""
-        n_win = int(np.searchsorted(rec.time[:hi], rec.time[hi - 1] - self.window - 1e-12))
-        length = hi - n_win  # frames in the window of the last frame (uniform recording)
-        if length < 5:
+        length = self.window_frames
+        if hi < length:
             return None
         first = max(lo, length - 1)
         start = first - length + 1
