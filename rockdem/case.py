@@ -9,6 +9,7 @@ in :data:`LOADINGS`. Units: SI, angles in degrees where the key says ``_deg``.
 from __future__ import annotations
 
 import copy
+import json
 import math
 import os
 import tomllib
@@ -25,6 +26,7 @@ from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
+from .stopping import STOP_MODES
 
 __all__ = [
     "Table",
@@ -34,6 +36,9 @@ __all__ = [
     "LOADINGS",
     "load_case",
     "parse_case",
+    "CaseTemplate",
+    "template_key",
+    "SWAPPABLE_LOADINGS",
     "example_names",
     "example_case",
     "apply_overrides",
@@ -219,6 +224,7 @@ class RunOptions:
     record_interval: float = 0.002
     contact_tolerance: float | None = None
     contact_interval: float | None = None
+    stop: str = "off"
 
 
 @dataclass(frozen=True, repr=False)
@@ -468,11 +474,7 @@ def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, 
     return out
 
 
-def parse_case(data: Mapping[str, Any]) -> Case:
-    """Validate a case dict and build its model."""
-    top = Table(data, "case")
-    name = top.string("name", "case")
-    top.string("description", "")
+def _run_options(top: Table) -> RunOptions:
     run_t = top.sub("run")
     run = RunOptions(
         duration=run_t.number("duration", positive=True),
@@ -483,8 +485,13 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
         contact_interval=run_t.optional_number("contact_interval", positive=True),
+        stop=run_t.string("stop", "off", choices=STOP_MODES),
     )
     run_t.finish()
+    return run
+
+
+def _damping(top: Table) -> Damping:
     damp_t = top.sub("damping")
     damping = Damping(
         alpha=damp_t.number("alpha", 0.0, min_=0.0),
@@ -493,12 +500,21 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         local=damp_t.number("local", 0.0, min_=0.0),
     )
     damp_t.finish()
+    return damping
+
+
+def _specimen(top: Table) -> tuple[ModelBuilder, dict[str, Monitor]]:
     spec_t = top.sub("specimen")
     kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
     grav = spec_t.number("gravity", 9.81, min_=0.0)
     builder = ModelBuilder(gravity=(0.0, 0.0, -grav))
     monitors = SPECIMENS[kind](spec_t, builder)
     spec_t.finish()
+    return builder, monitors
+
+
+def _loading(top: Table, builder: ModelBuilder, monitors: dict[str, Monitor], run: RunOptions) -> dict[str, Any]:
+    """Apply ``[loading]`` to the builder; returns the context (attrs, series, rocking_axis)."""
     load_t = top.sub("loading")
     lkind = load_t.string("type", "gravity", choices=tuple(sorted(LOADINGS)))
     ctx: dict[str, Any] = {"run": run, "attrs": {"loading": lkind}, "series": {}}
@@ -507,6 +523,10 @@ def parse_case(data: Mapping[str, Any]) -> Case:
     pga = ctx["attrs"].get("earthquake_pga_m_s2")
     if isinstance(pga, float) and "pga_g" not in load_t.data:  # a record scaled by ``scale``
         check_plausible(float(f"{pga / STANDARD_GRAVITY:.4g}"), "[loading] the scaled record's peak ground acceleration [g] (see scale)", "pga_g")
+    return ctx
+
+
+def _output(top: Table) -> dict[str, Any]:
     out_t = top.sub("output")
     output = {
         "directory": out_t.string("directory", ""),
@@ -517,13 +537,92 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
-    top.finish()
-    model = builder.finalize(
-        damping=damping,
-        rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
-        contact_tolerance=run.contact_tolerance,
-    )
-    return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+    return output
+
+
+def parse_case(data: Mapping[str, Any]) -> Case:
+    """Validate a case dict and build its model."""
+    return CaseTemplate(data).case
+
+
+SWAPPABLE_LOADINGS = ("earthquake",)
+"""Loading types that only set a model's prescribed kinematics (ground motion, body acceleration),
+so that a :class:`CaseTemplate` swaps them without rebuilding the geometry."""
+
+
+def template_key(data: Mapping[str, Any]) -> str:
+    """Cases with equal keys have the same model geometry, materials and initial pose: the
+    ``[specimen]`` table, ``run.contact_tolerance`` and, unless its type is one of
+    :data:`SWAPPABLE_LOADINGS`, the ``[loading]`` table (damping and run options are swapped)."""
+    data = Table(data, "case").data  # a mapping, or the error a case file gets
+    load = data.get("loading", {})
+    swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
+    run = data.get("run", {})
+    key = {
+        "specimen": data.get("specimen"),
+        "contact_tolerance": run.get("contact_tolerance") if isinstance(run, Mapping) else None,
+        "loading": {"type": load.get("type")} if swap else load,
+    }
+    return json.dumps(key, sort_keys=True, separators=(",", ":"), default=str)
+
+
+class CaseTemplate:
+    """A parsed case whose model is reused by cases that differ only in damping, run options,
+    output and, for a swappable loading (:data:`SWAPPABLE_LOADINGS`), the loading itself (another
+    record, scale or PGA): :meth:`derive` validates such a case as :func:`parse_case` does and
+    swaps the new damping and input arrays into the model (:meth:`rockdem.model.Model.with_inputs`)
+    without rebuilding blocks, interface points or the contact geometry. The models are the ones
+    :func:`parse_case` builds, array for array.
+
+    Attributes:
+        key: :func:`template_key` of the cases it serves.
+        case: the parsed case of ``data``.
+    """
+
+    def __init__(self, data: Mapping[str, Any]) -> None:
+        top = Table(data, "case")
+        self.key = template_key(data)
+        name = top.string("name", "case")
+        top.string("description", "")
+        run = _run_options(top)
+        damping = _damping(top)
+        builder, monitors = _specimen(top)
+        load = top.data.get("loading", {})
+        self._swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
+        self._bare = copy.copy(builder) if self._swap else None  # before the loading
+        self._monitors = dict(monitors)
+        ctx = _loading(top, builder, monitors, run)
+        output = _output(top)
+        top.finish()
+        model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
+                                 contact_tolerance=run.contact_tolerance)
+        self._ctx = ctx
+        self.case = Case(name, model, run, dict(monitors), output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+    def derive(self, data: Mapping[str, Any]) -> Case:
+        """The case of ``data`` (same :func:`template_key`), built on this template's model."""
+        top = Table(data, "case")
+        if template_key(data) != self.key:
+            raise ValueError("CaseTemplate.derive: the case's specimen or loading differs from the template's")
+        name = top.string("name", "case")
+        top.string("description", "")
+        run = _run_options(top)
+        damping = _damping(top)
+        top.used.add("specimen")  # equal to the template's (the key)
+        model = self.case.model
+        if self._swap:
+            builder, monitors = copy.copy(self._bare), dict(self._monitors)
+            ctx = _loading(top, builder, monitors, run)
+            if tuple(ctx.get("rocking_axis", (0.0, 1.0, 0.0))) != tuple(self._ctx.get("rocking_axis", (0.0, 1.0, 0.0))):
+                raise ValueError("CaseTemplate.derive: the loading changed the rocking axis")
+            model = model.with_inputs(damping=damping, builder=builder)
+        else:
+            top.used.add("loading")
+            ctx, monitors = self._ctx, dict(self.case.monitors)
+            model = model.with_inputs(damping=damping)
+        output = _output(top)
+        top.finish()
+        return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
 
 
 def _register_builtin_types() -> None:

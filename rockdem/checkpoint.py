@@ -121,6 +121,9 @@ class Checkpoint:
         model_hash, structure_hash: the model's :func:`model_hash` and :func:`structure_hash`.
         runtime_s: wall time spent on the run so far [s].
         fresh: True after :meth:`reset_clock`: a new run starts at t = 0 from this state.
+        check_target: for a run with a stop rule (:mod:`rockdem.stopping`) whose end cut its last
+            chunk short, the time [s] that chunk was to end at: a continuation ends its first chunk
+            there, so that its stop checks fall where an uninterrupted run's do; else None.
     """
 
     state: State
@@ -137,6 +140,7 @@ class Checkpoint:
     runtime_s: float = 0.0
     fresh: bool = False
     block_names: tuple[str, ...] = field(default_factory=tuple)
+    check_target: float | None = None
 
     @property
     def time(self) -> float:
@@ -159,7 +163,7 @@ class Checkpoint:
         state.energy[:] = 0.0
         empty = Records(*(a[:0] for a in self.records))
         return replace(self, state=state, scratch=scratch, records=empty, frame=0, snapshot_count=0,
-                       snapshots={}, runtime_s=0.0, fresh=True)
+                       snapshots={}, runtime_s=0.0, fresh=True, check_target=None)
 
     def check_model(self, model: Model) -> None:
         """Raise ValueError unless ``model`` is the one this checkpoint was saved from (the same
@@ -189,7 +193,7 @@ class Checkpoint:
             "structure_hash": self.structure_hash, "frame": self.frame, "record_interval": self.record_interval,
             "contact_interval": self.contact_interval, "snapshot_count": self.snapshot_count,
             "timestep": self.timestep.__dict__, "runtime_s": self.runtime_s, "fresh": self.fresh,
-            "block_names": list(self.block_names), "time": self.time,
+            "block_names": list(self.block_names), "time": self.time, "check_target": self.check_target,
         }
         arrays: dict[str, np.ndarray] = {"meta": np.array(json.dumps(meta))}
         for prefix, nt in (("state", self.state), ("scratch", self.scratch), ("records", self.records)):
@@ -247,6 +251,7 @@ class Checkpoint:
             snapshot_count=int(meta["snapshot_count"]), snapshots=snaps, timestep=TimestepInfo(**meta["timestep"]),
             model_hash=meta["model_hash"], structure_hash=meta["structure_hash"], runtime_s=float(meta["runtime_s"]),
             fresh=bool(meta["fresh"]), block_names=tuple(meta["block_names"]),
+            check_target=meta.get("check_target"),  # absent in files written before stop rules
         )
 
     def engine_arrays(self, model: Model) -> tuple[State, Scratch]:

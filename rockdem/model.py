@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -179,6 +179,20 @@ class Model:
     @property
     def point_count(self) -> int:
         return int(self.arrays.point_area.shape[0])
+
+    def with_inputs(self, *, damping: Damping | None = None, builder: ModelBuilder | None = None) -> Model:
+        """This model with another damping and/or the prescribed kinematics (ground motion, body
+        acceleration, driven motions) of ``builder``, whose blocks must be this model's: the
+        geometry is not rebuilt. The arrays are those :meth:`ModelBuilder.finalize` would give."""
+        fields: dict[str, Any] = {}
+        if damping is not None:
+            damping.validate()
+            fields.update(damping_arrays(self.materials, self.group_names, damping))
+        if builder is not None:
+            if tuple(builder.block_names()) != self.block_names:
+                raise ValueError("with_inputs: the builder's blocks are not this model's")
+            fields.update(builder.input_arrays())
+        return replace(self, arrays=self.arrays._replace(**fields), damping=damping if damping is not None else self.damping)
 
     def summary(self) -> dict[str, str]:
         """Short description, label -> text: blocks, points, groups, joints, damping, loading, size."""
@@ -480,6 +494,36 @@ class ModelBuilder:
             raise ValueError("body acceleration: acceleration values must be finite")
         self.body_acceleration = (t, a)
 
+    def input_arrays(self) -> dict[str, Any]:
+        """The prescribed-kinematics fields of :class:`ModelArrays` (``block_motion``,
+        ``motion_start``, ``motion_time``, ``motion_velocity``, ``ground_motion``, ``body_time``,
+        ``body_acceleration``) of the blocks and loading set so far. :meth:`finalize` uses it, and
+        :meth:`Model.with_inputs` swaps them into a built model (another record or scale)."""
+        motions: list[Motion] = []
+        ground_index = -1
+        if self.ground_motion is not None:
+            motions.append(self.ground_motion)
+            ground_index = 0
+        block_motion = []
+        for blk in self._blocks:
+            if isinstance(blk.driven, Motion):
+                motions.append(blk.driven)
+                block_motion.append(len(motions) - 1)
+            elif blk.driven == GROUND:
+                block_motion.append(ground_index)
+            else:
+                block_motion.append(-1)
+        bt, ba = self.body_acceleration if self.body_acceleration is not None else (np.zeros(0), np.zeros((0, 3)))
+        return {
+            "block_motion": np.array(block_motion, dtype=np.int64),
+            "motion_start": np.cumsum([0] + [len(mo.time) for mo in motions]).astype(np.int64),
+            "motion_time": np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0),
+            "motion_velocity": np.concatenate([mo.velocity for mo in motions]) if motions else np.zeros((0, 3)),
+            "ground_motion": int(ground_index),
+            "body_time": bt,
+            "body_acceleration": ba,
+        }
+
     # -- freeze -------------------------------------------------------------------------------
     def finalize(
         self,
@@ -517,7 +561,7 @@ class ModelBuilder:
                         "set_material(...) for that pair or set builder.default_material"
                     )
                 mats[(ga, gb)] = mat
-        tables = {name: np.zeros((ng, ng)) for name in ("kn", "ks", "c", "ft", "tf", "rc", "rtf", "beta")}
+        tables = {name: np.zeros((ng, ng)) for name in ("kn", "ks", "c", "ft", "tf", "rc", "rtf")}
         bonded = np.zeros((ng, ng), dtype=np.bool_)
         for (ga, gb), mat in mats.items():
             a, b = gi[ga], gi[gb]
@@ -528,23 +572,9 @@ class ModelBuilder:
             tables["tf"][a, b] = mat.tan_friction
             tables["rc"][a, b] = mat.residual_cohesion
             tables["rtf"][a, b] = mat.tan_residual_friction
-            tables["beta"][a, b] = damping.beta if mat.beta is None else mat.beta
             bonded[a, b] = mat.bonded
-
-        motions: list[Motion] = []
-        ground_index = -1
-        if self.ground_motion is not None:
-            motions.append(self.ground_motion)
-            ground_index = 0
-        block_motion = []
-        for blk in self._blocks:
-            if isinstance(blk.driven, Motion):
-                motions.append(blk.driven)
-                block_motion.append(len(motions) - 1)
-            elif blk.driven == GROUND:
-                block_motion.append(ground_index)
-            else:
-                block_motion.append(-1)
+        inputs = self.input_arrays()
+        block_motion = inputs.pop("block_motion")
 
         nb = len(self._blocks)
         mass = np.zeros(nb)
@@ -596,10 +626,6 @@ class ModelBuilder:
             contact_tolerance = max(0.01 * min_dim, 1.5 * opening)
         if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
             raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
-        motion_t = np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0)
-        motion_v = np.concatenate([mo.velocity for mo in motions]) if motions else np.zeros((0, 3))
-        mstart = np.cumsum([0] + [len(mo.time) for mo in motions]).astype(np.int64)
-        bt, ba = self.body_acceleration if self.body_acceleration is not None else (np.zeros(0), np.zeros((0, 3)))
         axis = np.asarray(rocking_axis, dtype=float).reshape(3)
         if not np.linalg.norm(axis) > 0:
             raise ValueError("rocking_axis must be a non-zero 3-vector")
@@ -609,7 +635,7 @@ class ModelBuilder:
             block_inertia=inertia,
             block_inv_inertia=np.where(free_mask[:, None], 1.0 / inertia, 0.0),
             block_free=free_mask,
-            block_motion=np.array(block_motion, dtype=np.int64),
+            block_motion=block_motion,
             block_group=np.array([gi[blk.group] for blk in self._blocks], dtype=np.int64),
             block_radius=radius,
             **geometry,
@@ -620,18 +646,10 @@ class ModelBuilder:
             mat_tan_friction=tables["tf"],
             mat_res_cohesion=tables["rc"],
             mat_res_tan_friction=tables["rtf"],
-            mat_beta=tables["beta"],
             mat_bonded=bonded,
             gravity=self.gravity.copy(),
-            alpha=float(damping.alpha),
-            alpha_relative=bool(damping.alpha_relative),
-            local_damping=float(damping.local),
-            motion_start=mstart,
-            motion_time=motion_t,
-            motion_velocity=motion_v,
-            ground_motion=int(ground_index),
-            body_time=bt,
-            body_acceleration=ba,
+            **damping_arrays(mats, tuple(groups), damping),
+            **inputs,
             contact_tol=float(contact_tolerance),
             touch_tol=0.1 * float(contact_tolerance),
             **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0, free_mask),
@@ -661,6 +679,21 @@ class ModelBuilder:
         if not 0 <= i < len(self._blocks):
             raise IndexError(f"block id {i} out of range (0..{len(self._blocks) - 1})")
         return i
+
+
+def damping_arrays(materials: Mapping[tuple[str, str], JointMaterial], group_names: Sequence[str], damping: Damping) -> dict[str, Any]:
+    """The damping fields of :class:`ModelArrays`: ``mat_beta`` (ng, ng) [s] (a material's own
+    beta, else ``damping.beta``), ``alpha`` [1/s], ``alpha_relative``, ``local_damping``."""
+    gi = {g: k for k, g in enumerate(group_names)}
+    beta = np.zeros((len(group_names), len(group_names)))
+    for (ga, gb), mat in materials.items():
+        beta[gi[ga], gi[gb]] = damping.beta if mat.beta is None else mat.beta
+    return {
+        "mat_beta": beta,
+        "alpha": float(damping.alpha),
+        "alpha_relative": bool(damping.alpha_relative),
+        "local_damping": float(damping.local),
+    }
 
 
 def _short_list(names: Sequence[str], n: int = 6) -> str:

@@ -20,6 +20,7 @@ found by :func:`record_path`, in this order:
 from __future__ import annotations
 
 import argparse
+import functools
 import hashlib
 import os
 import re
@@ -747,6 +748,7 @@ SHIPPED_RECORDS: tuple[ShippedRecord, ...] = (
 """The records shipped in ``rockdem/data/ground-motions`` (details in that folder's SOURCES.md)."""
 
 
+@functools.lru_cache(maxsize=1)
 def records_folder() -> Path:
     """Folder of the shipped records (package data, installed with rockdem)."""
     return Path(str(resources.files("rockdem").joinpath("data", "ground-motions")))

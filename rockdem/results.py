@@ -46,7 +46,7 @@ from __future__ import annotations
 import os
 import uuid
 from pathlib import Path
-from typing import TYPE_CHECKING, Mapping
+from typing import TYPE_CHECKING, Mapping, NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -58,8 +58,24 @@ from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv", "contact_table", "write_contact_table",
-           "with_block_index"]
+__all__ = [
+    "build_dataset",
+    "block_eta",
+    "block_thickness",
+    "Pivot",
+    "rocking_pivots",
+    "ground_blocks",
+    "reference_rotations",
+    "rocking_angles",
+    "ground_displacement",
+    "monitor_displacements",
+    "save",
+    "load",
+    "export_csv",
+    "contact_table",
+    "write_contact_table",
+    "with_block_index",
+]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -79,10 +95,7 @@ def build_dataset(
 ) -> xr.Dataset:
     """Assemble the recorded frames and the model's static data into a Dataset."""
     t = rec.time
-    r = quats_to_matrices(rec.quaternion)  # (T, nb, 3, 3)
-    rref = quats_to_matrices(model.quaternion_ref)
-    rel_ref = np.einsum("tbij,bkj->tbik", r, rref)  # rotation since the untilted reference
-    rotvec = rotation_vector(rel_ref)
+    rel_ref, rotvec = reference_rotations(model, rec.quaternion)
     axis = model.rocking_axis
     names = np.array(model.block_names, dtype=object)
     ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": ("block", names, {"note": "block name"})})
@@ -92,10 +105,7 @@ def build_dataset(
     ds["block_quaternion"] = (("time", "block", "quat"), rec.quaternion, {"units": "1"})
     ds["block_velocity"] = (xyz, rec.velocity, {"units": "m/s"})
     ds["block_angular_velocity"] = (xyz, rec.omega, {"units": "rad/s"})
-    ground = ground_blocks(model)
-    u_ground = np.zeros((len(t), 3))
-    if ground.size:
-        u_ground = rec.position[:, ground[0]] - model.position0[ground[0]]  # they translate together
+    u_ground = ground_displacement(model, rec.position)
     moving = bool(np.any(u_ground != 0.0))
     ref = "ground" if moving else "fixed frame"
     rel_note = ("relative to the ground (the blocks added with driven='ground'); absolute in the *_absolute "
@@ -106,13 +116,9 @@ def build_dataset(
     ds["block_displacement"] = (xyz, u_abs - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
     ds["block_displacement_absolute"] = (xyz, u_abs, {"units": "m", "reference": "fixed frame", "note": abs_note})
     ds["block_rotation"] = (xyz, rotvec, {"units": "rad"})
-    ds["rocking_angle"] = (("time", "block"), rotvec @ axis, {"units": "rad", "axis": axis.tolist()})
+    ds["rocking_angle"] = (("time", "block"), rocking_angles(model, rotvec), {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)
-    mdisp = np.zeros((len(t), len(names), 3))
-    for k, name in enumerate(names):
-        b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
-        arm = p_ref - model.position_ref[b]
-        mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + rec.position[:, b] - p_ref
+    mdisp = monitor_displacements(model, rel_ref, rec.position, monitors)
     ds = ds.assign_coords(monitor=np.array(names, dtype=object) if names else np.zeros(0, dtype=object))
     mon = ("time", "monitor", "xyz")
     ds["monitor_displacement"] = (mon, mdisp - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
@@ -177,12 +183,97 @@ def build_dataset(
     return ds
 
 
+def reference_rotations(model: Model, quaternion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations since the untilted reference pose: matrices R(t) R_ref^T (T, nb, 3, 3) and their
+    rotation vectors (T, nb, 3) [rad], from recorded quaternions (T, nb, 4). :func:`build_dataset`
+    and the summary rows of studies both call this, so their values are bit-identical."""
+    r = quats_to_matrices(quaternion)  # (T, nb, 3, 3)
+    rref = quats_to_matrices(model.quaternion_ref)
+    rel_ref = r @ np.swapaxes(rref, -1, -2)
+    return rel_ref, rotation_vector(rel_ref)
+
+
+def rocking_angles(model: Model, rotvec: np.ndarray) -> np.ndarray:
+    """(T, nb) rotation about the model's rocking axis [rad] from rotation vectors (T, nb, 3)."""
+    return rotvec @ model.rocking_axis
+
+
+def ground_displacement(model: Model, position: np.ndarray) -> np.ndarray:
+    """(T, 3) displacement of the ground-following driven blocks [m] (zeros without any), from
+    recorded centroids (T, nb, 3): they translate together."""
+    ground = ground_blocks(model)
+    if not ground.size:
+        return np.zeros((position.shape[0], 3))
+    return position[:, ground[0]] - model.position0[ground[0]]
+
+
+def monitor_displacements(
+    model: Model, rel_ref: np.ndarray, position: np.ndarray, monitors: Mapping[str, tuple[int, np.ndarray]]
+) -> np.ndarray:
+    """(T, nm, 3) displacement of each monitor point from its reference (untilted) position, in the
+    model's fixed frame [m], from the rotations of :func:`reference_rotations` and centroids (T, nb, 3)."""
+    names = list(monitors)
+    mdisp = np.zeros((position.shape[0], len(names), 3))
+    for k, name in enumerate(names):
+        b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
+        arm = p_ref - model.position_ref[b]
+        mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + position[:, b] - p_ref
+    return mdisp
+
+
 def ground_blocks(model: Model) -> np.ndarray:
     """Ids of the driven blocks that follow the model's ground motion (``driven="ground"``)."""
     m = model.arrays
     if m.ground_motion < 0:
         return np.zeros(0, dtype=np.int64)
     return np.flatnonzero((m.block_motion == m.ground_motion) & ~m.block_free.astype(bool))
+
+
+class Pivot(NamedTuple):
+    """Rigid rocking of a free block about one edge of its base (reference, untilted pose).
+
+    Attributes:
+        eta: instability angle atan(half / height) [rad].
+        radius: distance R from the centroid to the pivot edge in the rocking plane [m].
+        inertia: moment of inertia I_O about the pivot edge (the rocking axis through it) [kg m^2].
+        mass: block mass [kg].
+    """
+
+    eta: float
+    radius: float
+    inertia: float
+    mass: float
+
+    @property
+    def p(self) -> float:
+        """Housner's frequency parameter sqrt(m g R / I_O) [rad/s] at g = 9.81 m/s^2 (sqrt(3 g / 4 R)
+        for a rectangular block)."""
+        return float(np.sqrt(self.mass * 9.81 * self.radius / self.inertia))
+
+
+def _base(model: Model, b: int) -> tuple[float, float, float] | None:
+    """(height of the centroid above the base, half base toward +d, half base toward -d) [m] of
+    free block b about the rocking direction d = rocking_axis x up; None without a rocking direction."""
+    m = model.arrays
+    g = m.gravity
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    d = np.cross(model.rocking_axis, up)
+    if np.linalg.norm(d) == 0:
+        return None
+    d /= np.linalg.norm(d)
+    rref = quats_to_matrices(model.quaternion_ref[b])
+    v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref.T
+    z = v @ up
+    size = float(np.ptp(v, axis=0).max())
+    base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
+    return -float(z.min()), float(np.max(base @ d)), -float(np.min(base @ d))
+
+
+def block_thickness(model: Model) -> np.ndarray:
+    """(nb,) smallest extent of each block along its principal axes [m]."""
+    m = model.arrays
+    v, start = m.vertex_local, m.block_vertex_start
+    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
 def block_eta(model: Model) -> np.ndarray:
@@ -192,25 +283,36 @@ def block_eta(model: Model) -> np.ndarray:
     above the base). The base face is the block's lowest vertices, so a reduced (chamfered) base
     gives the angle about the pivot the block actually rocks on, as :meth:`ModelBuilder.tilt` uses.
     The rocking direction is rocking_axis x up (up opposes gravity)."""
-    m = model.arrays
-    g = m.gravity
-    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    d = np.cross(model.rocking_axis, up)
     out = np.full(model.block_count, np.nan)
-    if np.linalg.norm(d) == 0:
-        return out
-    d /= np.linalg.norm(d)
-    rref = quats_to_matrices(model.quaternion_ref)
-    for b in np.flatnonzero(m.block_free):
-        v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref[b].T
-        z = v @ up
-        size = float(np.ptp(v, axis=0).max())
-        base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
-        height = -float(z.min())
-        half = min(float(np.max(base @ d)), -float(np.min(base @ d)))
+    for b in np.flatnonzero(model.arrays.block_free):
+        base = _base(model, int(b))
+        if base is None:
+            return out
+        height, plus, minus = base
+        half = min(plus, minus)
         if height > 0 and half > 0:
             out[b] = float(np.arctan2(half, height))
     return out
+
+
+def rocking_pivots(model: Model, block: int) -> tuple[Pivot, Pivot] | None:
+    """The two base edges of free block ``block``: toward +d (a positive ``rocking_angle`` tips the
+    block over it) and toward -d, d = rocking_axis x up; None when the block has no base to rock on."""
+    base = _base(model, block)
+    if base is None:
+        return None
+    height, plus, minus = base
+    if not (height > 0 and plus > 0 and minus > 0):
+        return None
+    m = model.arrays
+    rref = quats_to_matrices(model.quaternion_ref[block])
+    i_axis = float(np.sum(m.block_inertia[block] * (rref.T @ model.rocking_axis) ** 2))
+    mass = float(m.block_mass[block])
+    out = []
+    for half in (plus, minus):
+        r = float(np.hypot(half, height))
+        out.append(Pivot(float(np.arctan2(half, height)), r, i_axis + mass * r * r, mass))
+    return out[0], out[1]
 
 
 def _version() -> str:

@@ -18,8 +18,9 @@ from .case import Case, apply_overrides, example_case, example_names, load_case,
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, stop_on_signals
 from .results import export_csv, save, write_contact_table
 from .simulation import simulate
+from .stopping import STOP_MODES
 
-__all__ = ["run_case", "register_cli", "summary_lines"]
+__all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
 
 
 def run_case(
@@ -37,31 +38,26 @@ def run_case(
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
     ``initial``, ``checkpoint`` and ``checkpoint_every`` are :func:`~rockdem.simulation.simulate`'s.
     """
-    r = case.run
-    dur = duration if duration is not None else r.duration
-    if r.record_interval > dur:
-        raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
-    ds = simulate(
-        case.model,
-        dur,
-        dt=r.dt,
-        timestep_rule=r.timestep_rule,
-        safety=r.safety,
-        resolution=r.resolution,
-        record_interval=r.record_interval,
-        monitors=case.monitors,
-        progress=progress,
-        contact_interval=r.contact_interval,
-        initial=initial,
-        checkpoint=checkpoint,
-        checkpoint_every=checkpoint_every,
-    )
+    ds = simulate(case.model, **run_options(case, duration), progress=progress, initial=initial, checkpoint=checkpoint,
+                  checkpoint_every=checkpoint_every)
     ds.attrs.update(case.attrs)
     t = ds.time.values
     for name, (ts, values) in case.series.items():
         v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])
         ds[name] = (("time", "xyz"), v, {"units": "m/s2" if "acceleration" in name else "1"})
     return ds
+
+
+def run_options(case: Case, duration: float | None = None) -> dict[str, Any]:
+    """The :func:`rockdem.simulation.simulate` arguments of a case (``duration`` overrides
+    [run] duration), checked: the record interval must not exceed the simulated time."""
+    r = case.run
+    dur = duration if duration is not None else r.duration
+    if r.record_interval > dur:
+        raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
+    return {"duration": dur, "dt": r.dt, "timestep_rule": r.timestep_rule, "safety": r.safety, "resolution": r.resolution,
+            "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
+            "stop": r.stop}
 
 
 def _row(label: str, value: str, unit: str = "", note: str = "") -> str:
@@ -130,6 +126,10 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             lines.extend(_analysis_lines(ds, b, skip=("max_rotation_rad",) if b == peak_block else ()))
     else:
         lines.append(_row("recorded frames", f"{n}", "", "nothing to summarise"))
+    if a.get("stop_reason"):
+        what = {"overturned": f"block {a.get('stop_block')!r} overturned", "fell": f"block {a.get('stop_block')!r} fell",
+                "rest": "at rest after the input"}.get(a["stop_reason"], a["stop_reason"])
+        lines.append(f"STOPPED at t = {a['stop_time']:.4g} s: {what} (stop = {a.get('stop_rule')!r}); the outcome was decided")
     if a.get("diverged"):
         lines.append(f"DIVERGED at t = {a['diverged_time']:.4g} s: the result holds the sound frames before it")
     if a.get("interrupted"):
@@ -230,6 +230,8 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError("give --from CHECKPOINT (continue a run) or --settled CHECKPOINT (a new run from its state), not both")
     data = example_case(args.example) if args.example else load_case(args.case)
     data = apply_overrides(data, args.set or [])
+    if args.stop is not None:
+        data = apply_overrides(data, [f'run.stop="{args.stop}"'])
     t0 = time.perf_counter()
     case = parse_case(data)
     initial = None
@@ -267,7 +269,8 @@ def _run(args: argparse.Namespace) -> int:
         print("  " + _row("wrote", "", "", str(p)))
     if "checkpoint" in ds.attrs and (received or ds.attrs.get("interrupted")):
         src = f"--example {args.example}" if args.example else str(args.case)
-        print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else ""))
+        print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else "")
+              + (f" --stop {args.stop}" if args.stop else ""))
     if received or ds.attrs.get("interrupted"):  # stopped, or interrupted while saving (the save went on)
         return 128 + (received[0] if received else signal.SIGINT)
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
@@ -291,6 +294,9 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", help="output directory (default results/<case name>)")
     p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE", help="override a case value")
     p.add_argument("--duration", type=positive_float, help="simulated time [s], overrides [run] duration")
+    p.add_argument("--stop", choices=STOP_MODES, default=None,
+                   help="end the run once its outcome is decided: collapsed, or at rest after the input "
+                   "(default: [run] stop, off; docs/studies.md)")
     p.add_argument("--no-plot", action="store_true", help="do not write the PNG plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--from", dest="from_", metavar="CHECKPOINT",

@@ -8,6 +8,20 @@ breaks or its state is no longer finite (diverged), or when a free block leaves 
 (``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
 ``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
 ``interrupted``. A run can be saved to a checkpoint and continued exactly (:mod:`rockdem.checkpoint`).
+With ``stop=`` (:mod:`rockdem.stopping`) the loop checks between chunks of a fixed number of steps
+whether the outcome is decided (collapsed, or at rest after the input) and ends there
+(``attrs["stop_reason"]``, ``stop_time``). :func:`run_model` is the loop without the Dataset
+(studies summarise its raw frames).
+
+A run stopped by its stop rule and checkpointed: the result ends at the decided frame, but the
+checkpoint holds the state where the loop ended (the end of the chunk in which the decision was
+made, at most ``check_steps`` steps later) and every frame computed up to there. Continued with the
+same rule, it is decided again from the saved frames and the result is the stopped run's, steps
+included, without stepping further (but for the rest of a chunk cut short, below); continued with ``stop="off"`` (or another rule), it runs on
+past the decision. A checkpoint written where the end of a run cut a chunk short keeps the time the
+chunk was to end at (``Checkpoint.check_target``): the continuation ends its first chunk there, so
+its stop checks fall where an uninterrupted run's do and a continued run with ``stop=`` is bit for
+bit an uninterrupted one with the same rule (the steps past the decision included).
 """
 
 from __future__ import annotations
@@ -21,7 +35,7 @@ import time as _time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterator, Mapping, Sequence
+from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
 import numpy as np
 import xarray as xr
@@ -30,12 +44,13 @@ from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
-from .results import build_dataset
+from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
 from .state import grow_buffers, initial_state
+from .stopping import Decision, Stopper, StopRule, stop_rule
 from .timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, TimestepInfo, stable_timestep
 
-__all__ = ["simulate", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
+__all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
 
 Monitor = tuple[int | str, Sequence[float]]
 """A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
@@ -59,6 +74,7 @@ def simulate(
     progress: bool | None = None,
     contact_interval: float | None = None,
     max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
     initial: Checkpoint | str | os.PathLike[str] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float | None = None,
@@ -85,6 +101,11 @@ def simulate(
             default None: none recorded.
         max_steps: a run estimated to need more steps (duration / initial dt) is refused before it
             starts, with the estimate: an absurd stiffness, mass or damping would otherwise hang.
+        stop: end the run once its outcome is decided (:mod:`rockdem.stopping`): "off" (default),
+            "decided" (collapsed, or at rest after the input), "collapse" or "rest"; the result
+            then ends at that frame and says why and when (attrs ``stop_reason``, ``stop_time``,
+            ``stop_block``). A continued run may use another rule than the checkpoint's run (see
+            the module notes for a checkpoint of a stopped run).
         initial: a :class:`~rockdem.checkpoint.Checkpoint` (or its file) to continue: the result
             holds the checkpoint's frames followed by the new ones, bit for bit those of an
             uninterrupted run. The timestep and the record and contact intervals are the
@@ -104,6 +125,75 @@ def simulate(
         ValueError: bad options, a timestep longer than the run, more steps than ``max_steps``, or
             a checkpoint of another model.
     """
+    out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
+                    record_interval=record_interval, monitors=monitors, progress=progress,
+                    contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
+                    checkpoint=checkpoint, checkpoint_every=checkpoint_every)
+    ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
+    return out.snapshots.attach(ds)
+
+
+class Start(NamedTuple):
+    """What a run starts from: the timestep (:func:`rockdem.timestep.stable_timestep`) and the
+    initial state and scratch arrays (:func:`rockdem.state.initial_state`). They depend on the
+    model's geometry, materials, damping and initial pose, not on its prescribed inputs (ground
+    motion, body acceleration), so the runs of a study that only change the record reuse them."""
+
+    timestep: TimestepInfo
+    state: State
+    scratch: Scratch
+
+    def copy(self) -> Start:
+        """An independent copy (every array of the state and scratch tuples copied, field by field)."""
+        def dup(nt: Any) -> Any:
+            return type(nt)(*(a.copy() if isinstance(a, np.ndarray) else a for a in nt))
+
+        return Start(self.timestep, dup(self.state), dup(self.scratch))
+
+
+def prepare_start(model: Model, *, timestep_rule: str = "bound", safety: float = DEFAULT_SAFETY,
+                  resolution: float = DEFAULT_RESOLUTION, dt: float | None = None) -> Start:
+    """The :class:`Start` of a run of ``model`` with these timestep options."""
+    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    return Start(info, *initial_state(model))
+
+
+class RunOutput(NamedTuple):
+    """What :func:`run_model` returns: the recorded frames (Records trimmed to the result's
+    frames), the result's attributes, the checked monitors (name -> (block id, reference point
+    [m])) and the contact snapshots."""
+
+    records: Records
+    attrs: dict[str, Any]
+    monitors: dict[str, tuple[int, np.ndarray]]
+    snapshots: ContactSnapshots
+
+
+def run_model(
+    model: Model,
+    duration: float,
+    *,
+    dt: float | None = None,
+    timestep_rule: str | None = None,
+    safety: float | None = None,
+    resolution: float | None = None,
+    record_interval: float | None = None,
+    monitors: Mapping[str, Monitor] | None = None,
+    progress: bool | None = None,
+    contact_interval: float | None = None,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
+    start: Start | None = None,
+    initial: Checkpoint | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float | None = None,
+) -> RunOutput:
+    """:func:`simulate` without building the Dataset: the raw recorded frames and attributes
+    (studies summarise these directly; same arguments). ``attrs["kernel_s"]`` is the time spent
+    inside the compiled kernel in this call [s], ``runtime_s`` the whole loop's (with the
+    checkpoint's, continuing one). ``start``: the timestep and initial state of
+    :func:`prepare_start` for this model and these options (a copy, see :meth:`Start.copy`; the
+    run mutates it), computed here when None; not with ``initial``."""
     if not isinstance(model, Model):
         hint = " (call builder.finalize() first)" if type(model).__name__ == "ModelBuilder" else ""
         raise TypeError(f"simulate: model must be a rockdem Model{hint}, got {type(model).__name__}")
@@ -115,11 +205,14 @@ def simulate(
         if checkpoint is None:
             raise ValueError("checkpoint_every needs a checkpoint file: give checkpoint=PATH")
     mon = _check_monitors(model, monitors or {})
+    rule = stop_rule(stop)
+    if start is not None and initial is not None:
+        raise ValueError("give start (a prepared fresh start) or initial (a checkpoint), not both")
     ck = None if initial is None else load_checkpoint(initial)
     wall0 = _time.perf_counter()
     if ck is None or ck.fresh:
         run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
-                         contact_interval, max_steps)
+                         contact_interval, max_steps, start)
     else:
         run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
                              contact_interval, max_steps)
@@ -129,20 +222,34 @@ def simulate(
     m = model.arrays
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
-    thickness = _block_thickness(model)
+    thickness = block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
+    stopper = Stopper(model, rule, run.record_interval) if rule is not None else None
+    decision: Decision | None = None
+    # With a stop rule, chunks of check_steps steps: ``target`` is the time the current chunk ends at
+    # (a contact snapshot or the end of the run may cut it short); see the module notes.
+    target = run.check_target if stopper is not None else None
+    if stopper is not None and frame > 0 and target is None:
+        decision = stopper.check(rec, frame)  # a continued run: the saved frames may decide it already
+    kernel = 0.0
     bar = None
     interrupted = False
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
-        while state.time[0] < t_end and frame < frames:
+        while decision is None and state.time[0] < t_end and frame < frames:
             # A stop signal during a chunk is raised once the chunk's bookkeeping is done, so that the
             # state, the frame counter and the snapshots saved in a checkpoint belong together.
             with _deferred_signals():
-                stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
+                if stopper is not None:
+                    if target is None:
+                        target = float(state.time[0]) + stopper.rule.check_steps * float(state.dt[0])
+                    t_stop = snaps.clip(min(t_end, target))
+                else:
+                    t_stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
                 t0 = _time.perf_counter()
-                frame, status = advance(m, state, scratch, stop, run.record_interval, rec, frame)
+                frame, status = advance(m, state, scratch, t_stop, run.record_interval, rec, frame)
                 elapsed = _time.perf_counter() - t0
+                kernel += elapsed
                 if status == STATUS_GROW:
                     state, scratch = grow_buffers(state, scratch)
                     continue
@@ -152,8 +259,13 @@ def simulate(
                 if sunk is not None:
                     break
                 snaps.take(state)
-            chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
-            saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0)
+                if stopper is not None:
+                    # a new chunk starts here, unless the end of this run cut it short (kept for a continuation)
+                    target = target if t_stop == t_end < target else None
+                    decision = stopper.check(rec, frame)
+            if stopper is None:
+                chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+            saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0, target)
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
                 bar = _progress_bar(duration, run.start_time)
             if bar is not None:
@@ -163,6 +275,8 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
+    if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
+        decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
     runtime = _time.perf_counter() - wall0 + run.runtime_before
     attrs: dict[str, Any] = {
         "dt": info.dt,
@@ -174,12 +288,16 @@ def simulate(
         "timestep_rule": info.rule,
         "steps": int(state.step[0]),
         "runtime_s": runtime,
+        "kernel_s": kernel,
         "duration": duration,
         "record_interval": run.record_interval,
         "interrupted": int(interrupted),
+        "stop_rule": rule.mode if rule is not None else "off",
     }
     if run.continued_from is not None:
         attrs["continued_from_time"] = run.continued_from
+    if decision is not None:
+        attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
     if status in (STATUS_DIVERGED, STATUS_LOST):
         attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
         warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
@@ -191,8 +309,8 @@ def simulate(
         attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                       "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
-    elif checkpoint is not None:
-        attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime))
+    elif checkpoint is not None:  # every frame computed, also past a stop decision (see the module notes)
+        attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime, target))
     if attrs.get("diverged") and checkpoint is not None:
         attrs["checkpoint_note"] = "no checkpoint written: the run diverged"
     fell = np.flatnonzero(state.fell_off >= 0.0)
@@ -205,9 +323,8 @@ def simulate(
             "a larger foundation (the specimen builders' foundation_extent) keeps them",
             RuntimeWarning, stacklevel=2,
         )
-    rec = Records(*(a[:frame] for a in rec))
-    ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
-    return snaps.attach(ds)
+    end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
+    return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
 
 
 @dataclass
@@ -224,6 +341,7 @@ class _Run:
     start_time: float = 0.0
     runtime_before: float = 0.0
     continued_from: float | None = None
+    check_target: float | None = None  # the end of a stop-rule chunk the run that saved it did not reach
 
 
 def _frames(model: Model, duration: float, record_interval: float) -> Records:
@@ -241,16 +359,22 @@ def _frames(model: Model, duration: float, record_interval: float) -> Records:
 
 def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float | None, rule: str | None,
                safety: float | None, resolution: float | None, record_interval: float | None,
-               contact_interval: float | None, max_steps: int) -> _Run:
-    """A run from t = 0: the model's initial state, or a checkpoint's state with its clock reset."""
+               contact_interval: float | None, max_steps: int, start: Start | None = None) -> _Run:
+    """A run from t = 0: the model's initial state (``start``'s when given: its timestep and
+    arrays, used in place), or a checkpoint's state with its clock reset."""
     interval = _positive_number("record_interval", 0.002 if record_interval is None else record_interval, "s")
     safety = DEFAULT_SAFETY if safety is None else safety
     resolution = DEFAULT_RESOLUTION if resolution is None else resolution
     snaps = ContactSnapshots(model, contact_interval)
-    info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt)
+    if start is not None:
+        info = start.timestep
+    else:
+        info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt)
     _check_step_count(info, duration, max_steps)
     rec = _frames(model, duration, interval)
-    if ck is None:
+    if start is not None:
+        state, scratch = start.state, start.scratch
+    elif ck is None:
         state, scratch = initial_state(model)
     else:
         ck.check_model(model)
@@ -291,7 +415,8 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
         dst[: ck.frame] = src[: ck.frame]
     snaps = ContactSnapshots(model, ck.contact_interval)
     snaps.restore(ck.snapshots, ck.snapshot_count)
-    return _Run(ck.timestep, state, scratch, rec, ck.frame, ck.record_interval, snaps, ck.time, ck.runtime_s, ck.time)
+    return _Run(ck.timestep, state, scratch, rec, ck.frame, ck.record_interval, snaps, ck.time, ck.runtime_s, ck.time,
+                ck.check_target)
 
 
 class _Saver:
@@ -303,15 +428,16 @@ class _Saver:
         self.hashes = (model_hash(model), structure_hash(model)) if path is not None else ("", "")
 
     def save(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
-             runtime: float) -> Path:
-        """Write the checkpoint now (state after the last completed chunk, frames ``[:frame]``)."""
+             runtime: float, check_target: float | None) -> Path:
+        """Write the checkpoint now (state after the last completed chunk, frames ``[:frame]``, the
+        unreached end of a stop-rule chunk)."""
         assert self.path is not None
         ck = Checkpoint(
             state=state, scratch=scratch, records=Records(*(a[:frame] for a in rec)), frame=frame,
             record_interval=self.run.record_interval, contact_interval=snaps.interval, snapshot_count=snaps.count,
             snapshots=snaps.columns() if snaps.interval else {}, timestep=self.run.info,
             model_hash=self.hashes[0], structure_hash=self.hashes[1], runtime_s=runtime,
-            block_names=self.model.block_names,
+            block_names=self.model.block_names, check_target=check_target,
         )
         with _deferred_signals():
             p = ck.save(self.path)
@@ -319,10 +445,10 @@ class _Saver:
         return p
 
     def maybe(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
-              wall: float) -> None:
+              wall: float, check_target: float | None) -> None:
         """Save if ``every`` seconds of wall time passed since the last save."""
         if self.every is not None and _time.perf_counter() - self.last >= self.every:
-            self.save(state, scratch, rec, frame, snaps, wall + self.run.runtime_before)
+            self.save(state, scratch, rec, frame, snaps, wall + self.run.runtime_before, check_target)
 
 
 @contextlib.contextmanager
@@ -353,13 +479,6 @@ def _deferred_signals() -> Iterator[None]:
 SINK_FRACTION = 0.25
 """A run stops when a sub-contact's overlap exceeds this fraction of the thinner of its two blocks:
 the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
-
-
-def _block_thickness(model: Model) -> np.ndarray:
-    """(nb,) smallest extent of each block along its principal axes [m]."""
-    m = model.arrays
-    v, start = m.vertex_local, m.block_vertex_start
-    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
 def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | None:

@@ -163,3 +163,73 @@ def test_settled_state_starts_an_earthquake_case(tmp_path):
     ds = simulate(model, 0.3, initial=start, **RUN)
     np.testing.assert_array_equal(ds.block_position.values[0], start.state.position)
     assert ds.attrs["steps"] > 0 and ds.time.values[0] == 0.0
+
+
+# --- checkpoints of runs with a stop rule (rockdem.stopping) ---------------------------------------
+# The paper's Fig. 6A block (0.19 x 0.5 m) released from 90 % of eta, MP damped (alpha = 8): it comes
+# to rest at about 2.5 s, so stop="rest" decides it there; snapshots every 0.05 s cut chunks as well.
+STOP_RUN = {"record_interval": 0.005, "contact_interval": 0.05, "progress": False}
+
+
+@pytest.fixture(scope="module")
+def resting():
+    over = {"run.record_interval": 0.005, "specimen.height": 0.5, "specimen.width": 0.19, "damping.beta": 0.0,
+            "damping.alpha": 8.0}
+    return parse_case(apply_overrides(example_case("free-rocking"), [f"{k}={v}" for k, v in over.items()])).model
+
+
+@pytest.fixture(scope="module")
+def stopped(resting):
+    """The uninterrupted run with stop="rest" (to 4 s) and without a stop rule."""
+    return simulate(resting, 4.0, stop="rest", **STOP_RUN), simulate(resting, 4.0, **STOP_RUN)
+
+
+def test_continued_run_with_a_stop_rule_is_bit_identical(resting, stopped, tmp_path):
+    # cut at 1.02 s, before the decision and between two contact snapshots (which end chunks too):
+    # the continuation with the same rule gives the decision, the frames, the snapshots and the steps
+    # past the decision of the uninterrupted run (a chunk cut short by the end of a run: see
+    # test_stop_decided_in_the_chunk_cut_by_the_end_of_a_run)
+    one, _ = stopped
+    assert one.attrs["stop_reason"] == "rest" and 1.5 < one.attrs["stop_time"] < 3.5
+    first = simulate(resting, 1.02, stop="rest", checkpoint=tmp_path / "a.npz", **STOP_RUN)
+    assert "stop_reason" not in first.attrs
+    ck = Checkpoint.load(tmp_path / "a.npz")
+    assert ck.check_target is not None and ck.check_target > ck.time
+    cont = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, cont)
+    for key in ("steps", "dt_min", "stop_reason", "stop_time", "stop_block"):
+        assert cont.attrs[key] == one.attrs[key], key
+
+
+def test_checkpoint_of_a_stopped_run_continues_as_decided_or_runs_on(resting, stopped, tmp_path):
+    one, full = stopped
+    again = simulate(resting, 4.0, stop="rest", checkpoint=tmp_path / "s.npz", **STOP_RUN)
+    ck = Checkpoint.load(tmp_path / "s.npz")
+    # the checkpoint holds the state where the loop ended and every frame computed up to there
+    assert ck.frame >= again.sizes["time"] and ck.time > again.attrs["stop_time"]
+    assert int(ck.state.step[0]) == again.attrs["steps"]
+    # the same rule: decided from the saved frames, nothing stepped
+    same = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, same)
+    assert same.attrs["steps"] == one.attrs["steps"] and same.attrs["stop_time"] == one.attrs["stop_time"]
+    # without a stop rule it runs on to the end: the uninterrupted run without one
+    on = simulate(resting, 4.0, initial=ck, progress=False)
+    assert "stop_reason" not in on.attrs and on.attrs["stop_rule"] == "off"
+    assert_identical(full, on)
+    assert on.attrs["steps"] == full.attrs["steps"]
+
+
+def test_stop_decided_in_the_chunk_cut_by_the_end_of_a_run(resting, tmp_path):
+    # the first run ends 1 ms after the decided frame, inside the chunk of check_steps steps where the
+    # uninterrupted run decided it (no snapshots here to cut that chunk): it stops at its own end;
+    # continued, it computes the rest of that chunk first, so that its state (the steps past the
+    # decision) is the uninterrupted run's
+    run = {**STOP_RUN, "contact_interval": None}
+    one = simulate(resting, 4.0, stop="rest", **run)
+    short = simulate(resting, one.attrs["stop_time"] + 0.001, stop="rest", checkpoint=tmp_path / "c.npz", **run)
+    assert short.attrs["stop_time"] == one.attrs["stop_time"] and short.attrs["steps"] < one.attrs["steps"]
+    ck = Checkpoint.load(tmp_path / "c.npz")
+    assert ck.check_target is not None
+    cont = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, cont)
+    assert cont.attrs["steps"] == one.attrs["steps"]
