@@ -61,7 +61,7 @@ def test_tilted_drop_conserves_energy():
     assert abs(err) < 0.01
 
 
-SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge", "tip_over_edge", "corner_near_edge"]
+SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge", "tip_over_edge", "corner_near_edge", "facade_topple"]
 
 
 @pytest.mark.parametrize("name", SHORT)
@@ -75,6 +75,11 @@ def test_collapse_scenario(name):
     if name == "ridge_to_ridge":  # apart: no force, nothing moves
         assert float(np.abs(ds.block_velocity.values).max()) == 0.0
     if name == "random_pile":  # comes to rest on the ground
+        assert out.final_kinetic < 1e-3 * out.energy_scale
+    if name == "facade_topple":  # it toppled outward and lies on its face, at rest
+        b = sc.model.block_id("facade")
+        assert ds.block_position.values[-1, b, 0] < -0.3
+        assert abs(ds.block_position.values[-1, b, 2] - 0.11 / 2) < 0.005
         assert out.final_kinetic < 1e-3 * out.energy_scale
     if name == "tip_over_edge":  # it tipped over the support's edge and fell off it
         assert scenarios._lowest_z(sc.model, ds, "block") < 0.3 - 0.05
