@@ -20,6 +20,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from .beta_choice import BETA_AUTO, BETA_MODES
 from .geometry import MAX_FACE_POINTS
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
@@ -472,14 +473,7 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
     )
     run_t.finish()
-    damp_t = top.sub("damping")
-    damping = Damping(
-        alpha=damp_t.number("alpha", 0.0, min_=0.0),
-        beta=damp_t.number("beta", 0.0, min_=0.0),
-        alpha_relative=damp_t.boolean("alpha_relative", False),
-        local=damp_t.number("local", 0.0, min_=0.0),
-    )
-    damp_t.finish()
+    damping = _damping(top.sub("damping"))
     spec_t = top.sub("specimen")
     kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
     grav = spec_t.number("gravity", 9.81, min_=0.0)
@@ -508,6 +502,46 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         contact_tolerance=run.contact_tolerance,
     )
     return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+
+_AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")
+
+
+def _damping(t: Table) -> Damping:
+    """``[damping]``: alpha, beta (a number [s], ``"auto"`` or ``"critical"``), alpha_relative, local,
+    and for an automatic beta target_restitution, per_interface, release_fraction, probe_impacts
+    (``"auto"``) and damping_ratio (``"critical"``, and the other pairs of ``per_interface``)."""
+    raw = t.raw("beta", 0.0)
+    if isinstance(raw, str):
+        if raw not in BETA_MODES:
+            raise ValueError(
+                f"[{t.where}] beta must be a number [s], 'auto' (targeted to target_restitution) or 'critical' "
+                f"(each group pair 2 zeta / omega of its own impact), got {raw!r}"
+            )
+        beta: float | str = raw
+    else:
+        beta = t.number("beta", 0.0, min_=0.0)
+    given = [k for k in _AUTO_KEYS if k in t.data]
+    if given and beta != BETA_AUTO:
+        raise ValueError(f"[{t.where}] {', '.join(given)} only apply to beta = \"auto\" (beta is {beta!r}); set beta = \"auto\"")
+    if "damping_ratio" in t.data and not isinstance(beta, str):
+        raise ValueError(f"[{t.where}] damping_ratio only applies to beta = \"critical\" or \"auto\" (beta is {beta!r})")
+    target = t.raw("target_restitution", "0.95eta")
+    if isinstance(target, bool) or not isinstance(target, (str, int, float)):
+        raise ValueError(f"[{t.where}] target_restitution must be 'eta', a multiple such as '0.95eta', or a number in (0, 1), got {target!r}")
+    out = Damping(
+        alpha=t.number("alpha", 0.0, min_=0.0),
+        beta=beta,
+        alpha_relative=t.boolean("alpha_relative", False),
+        local=t.number("local", 0.0, min_=0.0),
+        target_restitution=target,
+        damping_ratio=t.number("damping_ratio", 1.0, positive=True),
+        per_interface=t.boolean("per_interface", False),
+        release_fraction=t.optional_number("release_fraction", positive=True),
+        probe_impacts=t.integer("probe_impacts", 0, min_=0),
+    )
+    t.finish()
+    return out
 
 
 def _register_builtin_types() -> None:

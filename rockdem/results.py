@@ -22,7 +22,11 @@ Variables (dims; units in each variable's ``units`` attribute):
   static: block_mass, block_free, block_group, block_name (block); the geometry for plots and
   VTK: vertex_local (vertex, xyz) [m] in the body frames, face_vertex (corner) global vertex ids,
   face_corner_start (face+1), block_face_start (block+1), point_count (block).
-Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, displacement_reference, ...
+Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, displacement_reference, ...;
+with ``damping.beta = "auto"`` or ``"critical"`` also how beta was chosen: beta_mode, beta_pairs,
+beta_how, and for "auto" beta_target_restitution, beta_target_value, beta_achieved_e_a,
+beta_iterations, beta_search_beta / beta_search_e_a (every probe run), beta_search_time_s
+(:meth:`rockdem.beta_choice.BetaChoice.attrs`).
 
 Response displacements are relative to the ground by default. Under an earthquake applied as
 foundation motion (``mode="foundation"``) the ground-following blocks move with the record's
@@ -162,6 +166,8 @@ def build_dataset(
             "displacement_reference": ref,
         }
     )
+    if model.beta_choice is not None:
+        ds.attrs.update(model.beta_choice.attrs())
     return ds
 
 
