@@ -7,7 +7,9 @@ model until its half-cycle peaks fall below 2 % of the release (``--probe-releas
 another release than the run's, a check that is not true by construction); prints per case the targeted beta,
 the search's probe runs and wall time, the probe's e_a and the run's mean e_a (paper Eq. 6, as
 ``rockdem run`` reports it) against the target, and beside them DeJong's beta (the advisor's) with
-its mean e_a. The check of issue 14: the run's mean e_a within 2 % of the target on every case.
+its mean e_a. The check: the run's mean e_a within 2 % of the target on every case. Then (or
+alone, ``--facade``) the §4.2 one-sided façade's free rocking with per-interface critical betas against
+one beta: steps and best-of-3 wall time (the check: per-interface at most 1.5 times one critical beta).
 """
 
 from __future__ import annotations
@@ -71,6 +73,37 @@ def run_case(hb: float, points: int, release: float, target: str, probe_release:
             "ratio": mean / choice.target_value, "beta_dejong": 2.0 / omega, "mean_dejong": dj, "duration": dur}
 
 
+def bench_facade(repeat: int = 3) -> None:
+    """The §4.2 façade's 5 s free rocking: one beta (the paper's 0.00025 s; critical at the return walls)
+    against per-interface critical betas; best wall time of ``repeat`` serial runs each."""
+    import copy
+
+    from rockdem.case import parse_case
+    from rockdem.reproduce.damping import FACADE_CASE
+    from rockdem.run_cli import run_case
+
+    def case(beta: float | str):
+        data = copy.deepcopy(FACADE_CASE)
+        data["damping"] = {"beta": beta}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return parse_case(data)
+
+    ret = case("critical").model.beta_choice.pair("facade", "return").beta
+    print(f"\n§4.2 façade, 5 s of one-sided free rocking (best of {repeat} serial runs)")
+    print(f"{'beta':<50} {'steps':>8} {'wall [s]':>9} {'steps ratio':>11} {'wall ratio':>10}")
+    rows = []
+    for label, beta in (("paper best fit, one value 0.00025 s", 0.00025), (f"critical at the return walls, one value {ret:.4g} s", ret),
+                        ("critical per interface", "critical")):
+        c = case(beta)
+        best = min((run_case(c, progress=False) for _ in range(repeat)), key=lambda ds: ds.attrs["runtime_s"])
+        rows.append((label, best.attrs["steps"], best.attrs["runtime_s"]))
+    for label, steps, wall in rows:
+        print(f"{label:<50} {steps:>8} {wall:>9.3f} {steps / rows[0][1]:>11.2f} {wall / rows[0][2]:>10.2f}")
+    print(f"per interface / one critical value: steps {rows[2][1] / rows[1][1]:.2f}, wall {rows[2][2] / rows[1][2]:.2f} "
+          "(check: <= 1.5)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="H/B 1.5, 5, 20 with 2 and 15 points only")
@@ -79,7 +112,12 @@ def main() -> None:
     ap.add_argument("--probe-release", type=float, default=None,
                     help="release of the search's probe (default: the model's own, --release); another value checks "
                          "how far a beta found at one amplitude carries to a run from another")
+    ap.add_argument("--facade", action="store_true", help="only the §4.2 façade timings (per-interface vs one beta)")
     args = ap.parse_args()
+    if args.facade:
+        simulate(block_builder(WIDTH, 2.0, 2, 0.5).finalize(damping=Damping(beta=0.001)), 0.01, progress=False)
+        bench_facade()
+        return
     grid = [(hb, n) for hb in ((1.5, 5.0, 20.0) if args.quick else SLENDERNESS) for n in ((2, 15) if args.quick else POINTS)]
     block_builder(WIDTH, 2.0, 2, 0.5).finalize(damping=Damping(beta=0.001))  # compile outside the timings
     simulate(block_builder(WIDTH, 2.0, 2, 0.5).finalize(damping=Damping(beta=0.001)), 0.01, progress=False)
@@ -103,6 +141,7 @@ def main() -> None:
               f"{r['mean_dejong'] / r['target']:>8.3f} {r['duration']:>7.2f}", flush=True)
     print(f"largest |run mean e_a / target - 1| = {worst:.4f} (check: <= {TOLERANCE}); refused: {fails or 'none'}")
     print("'its mean' is the DeJong run's mean e_a over the same target (1 = on target).")
+    bench_facade()
 
 
 if __name__ == "__main__":

@@ -740,7 +740,7 @@ class ModelBuilder:
 
         choice = choose_beta(self, model)
         table = model.arrays.mat_beta.copy()
-        for (ga, gb), mat in mats.items():
+        for ga, gb in mats:
             table[gi[ga], gi[gb]] = choice.pair(ga, gb).beta
         return replace(model, arrays=model.arrays._replace(mat_beta=table), damping=replace(damping, beta=choice.beta),
                        beta_choice=choice)

@@ -234,7 +234,9 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     ``residual_disp_m`` / ``max_disp_m`` (first monitor, horizontal), ``e_a_mean``,
     ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``
     (the starting timestep), ``dt_min`` (the smallest, after any lowering at contact detections),
-    ``runtime_s`` (engine), ``wall_s`` (whole run), and ``history`` when asked for.
+    ``runtime_s`` (engine), ``wall_s`` (whole run), and ``history`` when asked for; with
+    ``damping.beta = "auto"`` or ``"critical"`` also ``beta_s``, ``beta_pairs`` and for "auto"
+    ``beta_target_value``, ``beta_achieved_e_a``, ``beta_iterations``, ``beta_search_time_s``.
     """
     from .analysis import summarize_result
     from .run_cli import run_case
@@ -276,6 +278,12 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     row["dt"] = float(a["dt"])
     row["dt_min"] = float(a["dt_min"])
     row["runtime_s"] = float(a["runtime_s"])
+    if a.get("beta_mode"):  # an automatic beta: the value chosen and how (rockdem.beta_choice)
+        row["beta_s"] = float(a["beta"])
+        row["beta_pairs"] = str(a["beta_pairs"])
+        for key in ("beta_target_value", "beta_achieved_e_a", "beta_iterations", "beta_search_time_s"):
+            if key in a:
+                row[key] = float(a[key])
     if spec.history:
         step = 1
         if spec.history_interval and len(t) > 1:

@@ -3,8 +3,8 @@
 The paper's DeJong rule beta = 2 / omega_e over-damped the §4.1 parapet (0.00305 s against the best
 fit 0.00068 s) and, as measured with rockdem, the apparent restitution it gives grows with the number
 of interface points (Fig. 9B). Instead of a formula, ask the model: release its rocking body from a
-tilt, let it make one or two impacts, measure the apparent restitution e_a from the rotation peaks
-(paper Eq. 6) and adjust beta until e_a equals the target (Housner's e_eta, 0.95 e_eta as Sorrentino
+tilt, let it rock, measure the apparent restitution e_a from the rotation peaks (paper Eq. 6) and
+adjust beta until e_a equals the target (Housner's e_eta, 0.95 e_eta as Sorrentino
 et al. suggest, or a measured value).
 
 **The probe.** A copy of the model (:meth:`rockdem.model.ModelBuilder.released_copy`) with the
@@ -16,23 +16,31 @@ released from ``fraction`` x eta (the model's own release fraction when it was t
 :data:`DEFAULT_RELEASE_FRACTION`) towards the model's tilt direction (else rocking_axis x up).
 
 **The run.** Housner's exact quarter period t_q(theta) of the assembly (p^2 = M g R / I_pivot,
-:func:`rockdem.housner.quarter_period`) gives the time to the n-th peak if each impact had the
-target restitution: t_q(theta_0) + 2 sum_{k<n} t_q(theta_k) + t_q(theta_n); the probe runs
-:data:`DURATION_MARGIN` times that (the elastic base makes the DEM block rock a little slower) and
-again twice as long if it has not yet made its n peaks. Frames every t_q(theta_n) /
-:data:`SAMPLES_PER_QUARTER` (the peaks are refined by a parabola through three samples, error far
-below the 0.1 % that matters here). e_a is the mean of Eq. 6's e_a(1..n) over the half-cycle peaks of
-the released blocks' mass-weighted rotation (peaks below 2 % of theta_0 are not counted, as
-:func:`rockdem.analysis.summarize` does); n = :data:`DEFAULT_IMPACTS`: the first impact alone is
-the most sensitive to the release; the mean over two is what a free-rocking run's mean e_a
-(dominated by its first impacts) follows.
+:func:`rockdem.housner.quarter_period`) predicts when the peaks come if every impact had the
+target restitution: t_q(theta_0) + 2 sum_k t_q(theta_k) up to the last peak measured; the probe
+runs :data:`DURATION_MARGIN` times that (the elastic base makes the DEM block rock a little slower),
+twice as long again while it has not made them, at most :data:`MAX_PROBE_QUARTERS` release quarter
+periods. Frames every t_q of the smallest measured half cycle / :data:`SAMPLES_PER_QUARTER` (the
+peaks are refined by a parabola through three samples: far below the 0.1 % that matters here).
+e_a is the mean of Eq. 6's e_a(1..n) over the half-cycle peaks of the released blocks' mass-weighted
+rotation, peaks below 2 % of theta_0 not counted, exactly as :func:`rockdem.analysis.summarize`
+(and ``rockdem run``) measures a free-rocking run. By default (``probe_impacts = 0``) the probe
+measures its whole free-rocking decay: in the DEM the impacts of small amplitude lose relatively
+more energy (e_a(n) of the paper's Table 2 block falls from 0.936 to 0.896 over 13 impacts at a
+constant beta), so matching only the first two impacts left the free-rocking runs' mean e_a of the benchmark
+up to 2.2 % below the target; ``probe_impacts = N`` matches the first N
+impacts only (the large-amplitude ones, shorter probes). A search takes 0.3 to 5 s
+(``benchmarks/bench_damping.py``).
 
 **The search.** e_a(beta) falls with beta over the range that matters, but not near beta = 0 (an
 undamped squat block can lose more energy by bouncing than a lightly damped one). So the bracket
-starts from the pair's critical beta 2 / omega (:mod:`rockdem.interfaces`) and steps by
-:data:`BRACKET_FACTOR` up or down until e_a crosses the target, then
-:func:`scipy.optimize.brentq` finds the root in log beta to :data:`LOG_BETA_TOL` (0.5 % of beta).
-A target outside the reachable range is an error that gives the range.
+starts from the rocking pair's critical beta 2 / omega (:mod:`rockdem.interfaces`) and steps by
+:data:`BRACKET_FACTOR` up (to at most xi = beta omega_max / 2 = :data:`MAX_XI`) or down until e_a
+crosses the target, then :func:`scipy.optimize.brentq` finds the root in ln beta to
+:data:`LOG_BETA_TOL` (0.5 % of beta). e_a(beta) of a DEM model has small steps (the timestep and
+contact events change with beta; a squat block's bounce is chaotic), so the beta kept is the probe
+run closest to the target, with a warning when it is more than :data:`CLOSE` off. A target outside
+the reachable range is an error that lists the e_a the probes reached.
 """
 
 from __future__ import annotations
@@ -41,7 +49,6 @@ import math
 import time
 import warnings
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -403,17 +410,3 @@ def _unreached(label: str, target: float, evals: list[ProbeResult], side: str, w
         f"damping.target_restitution = {label} (e = {target:.4f}) is {side} every apparent restitution this model reaches "
         f"({why}); probe runs gave e_a = {rng}. Give a target within that range, or damping.beta as a number or 'critical'"
     )
-
-
-def describe(choice: BetaChoice) -> dict[str, Any]:
-    """The choice as a JSON-ready dict (for the advisor's ``--json``)."""
-    return {
-        "mode": choice.mode,
-        "beta": choice.beta,
-        "target": choice.target,
-        "target_value": choice.target_value,
-        "achieved": choice.achieved,
-        "iterations": choice.iterations,
-        "search_time_s": choice.search_time,
-        "pairs": [{"pair": p.label, "beta_s": p.beta, "source": p.source, "omega_rad_s": p.omega, "how": p.how} for p in choice.pairs],
-    }
