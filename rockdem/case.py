@@ -515,7 +515,7 @@ def _damping(t: Table) -> Damping:
     if isinstance(raw, str):
         if raw not in BETA_MODES:
             raise ValueError(
-                f"[{t.where}] beta must be a number [s], 'auto' (targeted to target_restitution) or 'critical' "
+                f"[{t.where}] beta must be a finite number [s], 'auto' (targeted to target_restitution) or 'critical' "
                 f"(each group pair 2 zeta / omega of its own impact), got {raw!r}"
             )
         beta: float | str = raw

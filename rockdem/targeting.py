@@ -91,6 +91,13 @@ MAX_XI = 30.0
 at the release), i.e. an SP timestep reduction sqrt(1 + xi^2) - xi of at least 1/60: heavier damping
 would make every run of the model over 60 times longer than an undamped one. The 0.95 e_eta targets
 of blocks of H/B = 1.5 to 20 with 2 to 15 points need xi = 2 to 7 (benchmarks/bench_damping.py)."""
+MAX_PROBE_WORK = 5e8
+"""Largest probe run, in interface points of the probe model x steps (only a block's contacting
+faces' points work at each step: a single block's probe runs ~1e6 steps per second, a few seconds at
+most). The single blocks of the benchmark need 1e5 to 1e8 (E = 18 GPa with 15 points: 6e7); the §4.1
+parapet discretised brick by brick needs 3e9 at its first trial (stiff brick joints, a small step that
+SP damping shrinks further: hours for a search), so its search is refused with the estimate and the
+way around it."""
 CLOSE = 0.01
 """A targeted e_a further than this from the target (relative) is reported with a warning: e_a(beta)
 jumps there (a block that stops rebounding, a squat block's chaotic bounce)."""
@@ -180,10 +187,14 @@ def make_probe(builder: ModelBuilder, model: Model, *, fraction: float | None = 
         bodies: the model's blocks in their reference pose (default :func:`model_bodies`).
 
     Raises:
-        ValueError: no free block, or the released body rests on nothing.
+        ValueError: no gravity, or the released body rests on nothing.
     """
     rel = builder.release
-    up = -model.arrays.gravity / np.linalg.norm(model.arrays.gravity)
+    g = float(np.linalg.norm(model.arrays.gravity))
+    if not g > 0:
+        raise ValueError("beta = 'auto' needs gravity (a rocking body released from a tilt); this model has none: "
+                         "give damping.beta as a number or 'critical'")
+    up = -model.arrays.gravity / g
     if rel is not None:
         names, direction = list(rel.blocks), rel.direction
         frac = rel.fraction if fraction is None else fraction
@@ -259,6 +270,14 @@ def probe_restitution(
     """
     model = replace(probe.model, arrays=probe.model.arrays._replace(mat_beta=_beta_table(probe, beta, fixed or {})))
     duration, quarter = probe.duration(min(max(target, 0.05), 0.999), impacts)
+    work = duration / stable_timestep(model).dt * model.point_count
+    if work > MAX_PROBE_WORK:
+        raise ValueError(
+            f"beta = 'auto': a probe run of this model with beta = {beta:.3g} s would take about {duration / stable_timestep(model).dt:.3g} "
+            f"steps of {model.point_count} interface points ({work:.2g} point-steps, more than {MAX_PROBE_WORK:.0e}: minutes "
+            "to hours for the search). Search on the equivalent single block (the same geometry and joint stiffness as one "
+            "block, beta = 'auto') and give the beta found as a number, or use beta = 'critical'"
+        )
     longest = DURATION_MARGIN * MAX_PROBE_QUARTERS * probe.quarter(probe.geometry.angle)
     eta, th0 = probe.geometry.eta, probe.geometry.angle
     floor = SUMMARY_PEAK_PROMINENCE * th0

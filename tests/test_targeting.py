@@ -64,7 +64,7 @@ def test_bad_damping_options_name_the_field() -> None:
     case = example_case("free-rocking")
     with pytest.raises(ValueError, match=r"\[damping\] target_restitution only apply"):
         parse_case(apply_overrides(case, ["damping.target_restitution=0.9"]))  # beta is a number
-    with pytest.raises(ValueError, match=r"\[damping\] beta must be a number"):
+    with pytest.raises(ValueError, match=r"\[damping\] beta must be a finite number"):
         parse_case(apply_overrides(case, ["damping.beta=fast"]))
 
 
