@@ -216,10 +216,10 @@ class Advice:
         if c is not None:
             out["model_beta"] = {
                 "mode": c.mode, "beta_s": c.beta, "per_interface": c.per_interface or c.mode == "critical",
-                "target": c.target, "target_value": c.target_value, "achieved_e_a": c.achieved,
-                "probe_runs": c.iterations, "search_time_s": c.search_time, "release_fraction": c.release_fraction,
-                "pairs": [{"pair": p.label, "beta_s": p.beta, "source": p.source, "omega_rad_s": p.omega,
-                           "zeta": p.zeta, "how": p.how} for p in c.pairs],
+                "target": c.target, "target_value": _number(c.target_value), "achieved_e_a": _number(c.achieved),
+                "probe_runs": c.iterations, "search_time_s": c.search_time, "release_fraction": _number(c.release_fraction),
+                "pairs": [{"pair": p.label, "beta_s": p.beta, "source": p.source, "omega_rad_s": _number(p.omega),
+                           "zeta": _number(p.zeta), "how": p.how} for p in c.pairs],
                 "explanation": c.lines(),
             }
         return out
@@ -245,6 +245,11 @@ class Advice:
         if self.warnings:
             lines += ["", "Warnings:"] + [f"  ! {r}" for r in self.warnings]
         return "\n".join(lines)
+
+
+def _number(v: float) -> float | None:
+    """A float for JSON, None for nan (strict JSON has no NaN)."""
+    return float(v) if math.isfinite(v) else None
 
 
 def _configuration_text(i: AdviceInput) -> str:

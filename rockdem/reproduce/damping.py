@@ -356,6 +356,7 @@ def _comment(ctx: Context, t2: pd.DataFrame, f4: pd.DataFrame, par: pd.DataFrame
     crit, light = f.loc["critical per interface"], f.loc["paper best fit (one value)"]
     one_value = f.loc["critical at the return walls (one value)"]
     wme_col, steps_col = "WME vs the paper's best fit", "steps / the best-fit run's"
+    zeta_light = _measured_zeta(checks, {"return": paper.FACADE_BETA, "foundation": paper.FACADE_BETA})
     text = f"""
 **Point count (Table 2 block, Fig. 9B).** With the paper's beta 0.00693 s the mean e_a / e_eta goes from
 {t2[paper_col].iloc[0]:.3f} with {int(t2['points across'].iloc[0])} points to {t2[paper_col].iloc[-1]:.3f} with
@@ -382,8 +383,9 @@ times DeJong's: see docs/damping.md on the paper's Eq. 2) gives {f4['e_a/e_eta c
 {best} s, and its history is close to the best-fitting run's (WME {p.loc['targeted e_eta', wme_col]:.3f};
 the paper's formula value {formula} s: {p.loc['paper formula (§2.2)', wme_col]:.3f}). Targeted to
 0.95 e_eta it is {p.loc[tg, 'beta [s]'] if tg in p.index else float('nan'):.3g} s, beyond the formula value the paper found
-over-damped. The best fit keeps the mean e_a at {p.loc['paper best fit', 'e_a/e_eta']:.3f} e_eta on this model: the test
-lost about Housner's e_eta per impact, so the e_eta target lands on it and the 0.95 e_eta target over-damps. The
+over-damped. The paper's best-fit beta gives a mean e_a of {p.loc['paper best fit', 'e_a/e_eta']:.3f} e_eta on this model:
+as far as this model stands for the test, the test lost about Housner's e_eta per impact, so the e_eta target
+lands on it and the 0.95 e_eta target over-damps. The
 parapet's height (0.73 m) and release (50 % of eta) are inferred and assumed (the case file says how), so this
 agreement is indicative; for a test with a measured restitution, give that number as the target.
 
@@ -404,7 +406,8 @@ the tail: {int(light['outward peaks above 2 %'])} outward peaks above 2 % of the
 {light['late motion (t > 60 % of run) / release']:.2g} of it late in the run (the paper's undamped tail), against
 {int(crit['outward peaks above 2 %'])} with critical damping per interface and none late: the paper's over-damped
 regime (beta >= 0.002 s, "over-damped after the first impact"). So critical damping of both impacts does
-not reproduce the test either: the paper's best fit, 0.00025 s, is zeta = 0.15 to 0.2 at both impacts here,
+not reproduce the test either: the paper's best fit, 0.00025 s, is zeta = {zeta_light['base']:.2f} at the base and
+{zeta_light['return walls']:.2f} at the return walls here (from the same contact times),
 and what its tail lacks is damping at small amplitudes, which one viscous beta per pair cannot add. Fitting
 the test needs its own measured restitution as the target (beta = "auto" with a number); the paper does not
 print it, so that fit is left open here.
