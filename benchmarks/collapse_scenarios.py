@@ -205,6 +205,38 @@ def offset_pair(short: bool = False, *, offset: float = 0.03, scale: float = 5.0
     return Scenario("offset_pair", b.finalize(), dur, 0.01, "two offset bricks sliding and rocking on each other")
 
 
+def tip_over_edge(short: bool = False, *, offset: float = 0.005) -> Scenario:
+    """A 0.2 x 0.2 x 0.1 m block whose centroid is ``offset`` past the edge of a narrower support:
+    the support's edge lies under the middle of the block's bottom face, on the boundary between
+    its 2 x 2 interface cells, and the block tips over it and falls (the target's edge pressing
+    into the middle of the owner face: kernels/blend.py)."""
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = _mat(kn=2e9, friction=40.0)
+    add_foundation(b, 2.0)
+    b.add_box(0.3, 0.2, 0.3, base_center=(-0.15, 0.0, 0.0), driven=True, name="support")  # top face x in [-0.3, 0]
+    b.add_box(0.2, 0.2, 0.1, base_center=(offset, 0.0, 0.3), density=2000, name="block")
+    return Scenario("tip_over_edge", b.finalize(), 0.5 if short else 1.2, 0.002, "a block tipping over the edge of a narrower support")
+
+
+def corner_near_edge(short: bool = False, *, inset: float = 0.001) -> Scenario:
+    """A 0.12 m cube turned 25 deg about x and 35 deg about y, dropped from 50 mm so that its lowest
+    corner lands ``inset`` inside the edge of a 0.4 m support's top face while the cube overhangs
+    it: the corner's interface cell is almost all beyond the edge (lumped corner stiffness)."""
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = _mat(kn=2e9, friction=35.0)
+    add_foundation(b, 2.0)
+    b.add_box(0.4, 0.4, 0.2, base_center=(0.0, 0.0, 0.0), driven=True, name="support")
+    cube = box(0.12, 0.12, 0.12, name="cube")
+    cube = cube.transformed(axis_angle_matrix(np.array([1.0, 0, 0]), math.radians(25)) @ axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(35)), np.zeros(3))
+    low = cube.vertices[np.argmin(cube.vertices[:, 2])]
+    if low[0] > 0:  # turn it so that the cube lies beyond the edge, only its corner over the support
+        cube = cube.transformed(axis_angle_matrix(np.array([0, 0, 1.0]), math.pi), np.zeros(3))
+        low = cube.vertices[np.argmin(cube.vertices[:, 2])]
+    cube = cube.transformed(np.eye(3), [0.2 - inset - low[0], -low[1], 0.2 + 0.05 - low[2]])
+    b.add_block(cube, density=2000, name="cube")
+    return Scenario("corner_near_edge", b.finalize(), 0.3 if short else 0.8, 0.001, "a corner landing just inside a face's edge")
+
+
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "edge_on_wall": edge_on_wall,
     "ridge_to_ridge": ridge_to_ridge,
@@ -216,6 +248,8 @@ SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "drum_column_x2": drum_column,
     "topple_near_edge": topple_near_edge,
     "offset_pair": offset_pair,
+    "tip_over_edge": tip_over_edge,
+    "corner_near_edge": corner_near_edge,
 }
 
 

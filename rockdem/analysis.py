@@ -16,6 +16,7 @@ Definitions:
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,7 +40,9 @@ __all__ = [
     "rocking_onset_time",
     "summarize",
     "lowest_point_height",
+    "lowest_vertex_height",
     "result_eta",
+    "eta_of",
     "summarize_result",
 ]
 
@@ -133,21 +136,23 @@ def half_cycle_peaks(
     idx = idx - 1
     times, values = t[idx].copy(), x[idx].copy()
     if refine:
-        for k, i in enumerate(idx):
-            if 0 < i < len(x) - 1:
-                times[k], values[k] = _parabola_peak(t[i - 1 : i + 2], x[i - 1 : i + 2])
+        inner = idx[(idx > 0) & (idx < len(x) - 1)]
+        k = np.searchsorted(idx, inner)
+        times[k], values[k] = _parabola_peaks(t, x, inner)
     return HalfCyclePeaks(times, values)
 
 
-def _parabola_peak(t3: NDArray[np.float64], x3: NDArray[np.float64]) -> tuple[float, float]:
-    """Vertex of the parabola through three samples (falls back to the middle sample)."""
-    c = np.polyfit(t3 - t3[1], x3, 2)
-    if c[0] == 0.0:
-        return float(t3[1]), float(x3[1])
-    tv = -c[1] / (2.0 * c[0])
-    if not (t3[0] - t3[1] <= tv <= t3[2] - t3[1]):
-        return float(t3[1]), float(x3[1])
-    return float(t3[1] + tv), float(np.polyval(c, tv))
+def _parabola_peaks(t: NDArray[np.float64], x: NDArray[np.float64], i: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Vertices of the parabolas through the samples i-1, i, i+1 of each interior index ``i``
+    (time [s], value); the middle sample where the parabola is flat or its vertex falls outside."""
+    a, b = t[i - 1] - t[i], t[i + 1] - t[i]  # a < 0 < b
+    d0, d2 = x[i - 1] - x[i], x[i + 1] - x[i]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c2 = (d0 / a - d2 / b) / (a - b)  # x = x_i + c1 s + c2 s^2, s = time - t_i
+        c1 = d0 / a - c2 * a
+        sv = -c1 / (2.0 * c2)
+        ok = (c2 != 0.0) & (sv >= a) & (sv <= b)
+        return np.where(ok, t[i] + sv, t[i]), np.where(ok, x[i] + c1 * sv + c2 * sv * sv, x[i])
 
 
 def apparent_restitution(peaks: ArrayLike, theta0: float, eta: float, *, exact: bool = False) -> Restitution:
@@ -463,11 +468,22 @@ def lowest_point_height(ds: Any, block: int) -> NDArray[np.float64] | None:
         return None
     start = np.asarray(ds["block_vertex_start"].values, dtype=np.int64)
     v = np.asarray(ds["vertex_local"].values, dtype=float)[start[block] : start[block + 1]]
-    q = np.asarray(ds["block_quaternion"].values[:, block, :], dtype=float)
+    return lowest_vertex_height(ds["block_position"].values[:, block], ds["block_quaternion"].values[:, block], v)
+
+
+def lowest_vertex_height(position: ArrayLike, quaternion: ArrayLike, vertices: ArrayLike) -> NDArray[np.float64]:
+    """Height of a block's lowest vertex over time [m].
+
+    Args:
+        position: (T, 3) centroid [m].
+        quaternion: (T, 4) body -> world rotation (w, x, y, z).
+        vertices: (n, 3) the block's vertices in its body frame [m].
+    """
+    q = np.asarray(quaternion, dtype=float)
     w, x, y, zq = q.T
     row_z = np.column_stack((2 * (x * zq - w * y), 2 * (y * zq + w * x), 1 - 2 * (x * x + y * y)))
-    zc = np.asarray(ds["block_position"].values[:, block, 2], dtype=float)
-    return zc + np.min(row_z @ v.T, axis=1)
+    zc = np.asarray(position, dtype=float)[:, 2]
+    return zc + np.min(row_z @ np.asarray(vertices, dtype=float).T, axis=1)
 
 
 def result_eta(ds: Any, block: int) -> float | None:
@@ -477,11 +493,15 @@ def result_eta(ds: Any, block: int) -> float | None:
     angle ``tilt_angle_rad / tilt_fraction``; else ``block_eta[block]`` (the base contact face's
     edge, so a reduced parapet base counts); None when neither is known.
     """
-    a = getattr(ds, "attrs", {})
-    if int(a.get("tilted_blocks", 0)) > 1 and float(a.get("tilt_fraction", 0.0)) > 0:
-        return float(a["tilt_angle_rad"]) / float(a["tilt_fraction"])
-    if "block_eta" in ds.variables:
-        eta = float(ds["block_eta"].values[block])
+    return eta_of(getattr(ds, "attrs", {}), ds["block_eta"].values if "block_eta" in ds.variables else None, block)
+
+
+def eta_of(attrs: Mapping[str, Any], block_eta: ArrayLike | None, block: int) -> float | None:
+    """:func:`result_eta` from a result's attributes and its ``block_eta`` values (nb,) [rad]."""
+    if int(attrs.get("tilted_blocks", 0)) > 1 and float(attrs.get("tilt_fraction", 0.0)) > 0:
+        return float(attrs["tilt_angle_rad"]) / float(attrs["tilt_fraction"])
+    if block_eta is not None:
+        eta = float(np.asarray(block_eta)[block])
         return eta if np.isfinite(eta) else None
     return None
 

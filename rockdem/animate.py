@@ -1,4 +1,5 @@
-"""Animations of the recorded block motion: GIF (Pillow) or MP4 (ffmpeg).
+"""Animations of the recorded block motion: GIF (Pillow) or MP4 (H.264 through imageio-ffmpeg's
+own ffmpeg binary, installed with rockdem by pip: no system ffmpeg needed).
 
 Blocks are drawn from their geometry and recorded poses (world vertex = R(q) v_local + x), faces
 shaded by a fixed light, driven blocks in grey. Displacements and rotations since t = 0 can be
@@ -7,14 +8,20 @@ snapshots (``simulate(..., contact_interval=...)``); the failure counts are in e
 ``view="side"`` draws a 2D side view (projection on the plane normal to the rocking axis) for
 planar rocking; other views are 3D.
 
+Playback keeps real time by default (``speed`` = 1 simulated second per second): when the run
+needs more than ``max_frames`` frames at ``fps``, the frame rate is lowered (down to
+:data:`MIN_FPS`), and only then is the playback sped up, which every frame's title then states
+("2.2x real time", as the CLI does). GIF frame delays are whole hundredths of a second: the frame
+rate is rounded to one (20 fps = 5/100 s) and the frames chosen for it, so that timing stays exact.
+
 The CLI is ``rockdem animate RESULT.nc -o OUT.gif|mp4``.
 """
 
 from __future__ import annotations
 
 import argparse
-import shutil
-import subprocess
+import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
@@ -28,7 +35,14 @@ from .cli import integer_at_least, positive_float, positive_int
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices, rotation_vector
 from .plots import STYLE, Result, load_result, rocking_direction
 
-__all__ = ["VIEWS", "frame_indices", "posed_vertices", "render_frames", "animate", "register_cli"]
+__all__ = ["VIEWS", "MIN_FPS", "ANIMATION_STYLE", "Playback", "playback", "frame_indices", "posed_vertices",
+           "render_frames", "animate", "register_cli"]
+
+MIN_FPS = 5.0
+"""Lowest frame rate used to keep real time before the playback is sped up [frames/s]."""
+
+ANIMATION_STYLE: dict[str, object] = {**STYLE, "font.size": 10.0, "axes.titlesize": 12.0, "axes.labelsize": 10.0}
+"""Matplotlib settings of the animation frames (larger text than the static plots)."""
 
 VIEWS: dict[str, tuple[float, float] | None] = {
     "iso": (20.0, -60.0),
@@ -42,19 +56,69 @@ _LIGHT = np.array([0.3, -0.5, 0.8]) / np.linalg.norm([0.3, -0.5, 0.8])
 _FAIL_COLORS = {1: ("tab:orange", "failed in tension"), 2: ("tab:red", "failed in shear")}
 
 
-def frame_indices(time: np.ndarray, *, fps: float, speed: float, max_frames: int) -> np.ndarray:
-    """Recorded frames to show: one per 1/fps of playback at ``speed`` x real time, at most ``max_frames``."""
-    if fps <= 0 or speed <= 0 or max_frames < 1:
-        raise ValueError("fps, speed and max_frames must be positive; e.g. --fps 20 --speed 1 --max-frames 200")
+@dataclass(frozen=True)
+class Playback:
+    """How a run is played back.
+
+    Attributes:
+        frames: recorded frame indices shown, in order.
+        fps: frames per second of playback.
+        speed: simulated seconds per second of playback (1: real time).
+        requested_speed: the speed asked for; ``speed`` exceeds it when ``max_frames`` forced it.
+    """
+
+    frames: np.ndarray
+    fps: float
+    speed: float
+    requested_speed: float
+
+    @property
+    def sped_up(self) -> bool:
+        """Whether the playback is faster than asked for (the frame cap forced it)."""
+        return self.speed > self.requested_speed * (1.0 + 1e-9)
+
+    def note(self) -> str:
+        """One line: frames, rate and speed relative to real time."""
+        rate = "real time" if abs(self.speed - 1.0) < 1e-9 else f"{self.speed:.3g}x real time"
+        text = f"{self.frames.size} frames at {self.fps:.3g} fps, {rate}"
+        if self.sped_up:
+            text += f" (sped up from {self.requested_speed:g}x to fit max_frames: raise it to slow the playback)"
+        return text
+
+
+def _gif_rate(fps: float, gif: bool) -> float:
+    """The playback rate a GIF can hold: 100 / (whole hundredths of a second, at least 2)."""
+    return 100.0 / max(2, round(100.0 / fps)) if gif else fps
+
+
+def playback(time: np.ndarray, *, fps: float, speed: float, max_frames: int, gif: bool = False) -> Playback:
+    """The frames to show at ``speed`` x real time and ``fps``, at most ``max_frames`` of them:
+    the frame rate drops (to :data:`MIN_FPS` at least) before the speed rises. Each shown frame is
+    the recorded one nearest its playback time; ``gif`` rounds the rate to whole 1/100 s delays."""
+    if not (fps > 0 and speed > 0 and max_frames >= 1):
+        raise ValueError("fps, speed and max_frames must be positive; e.g. --fps 20 --speed 1 --max-frames 300")
     if time.size == 0:
         raise ValueError("the result has no recorded frame to animate")
-    step = speed / fps
     span = float(time[-1] - time[0])
-    if span / step + 1 > max_frames:
-        step = span / max(max_frames - 1, 1)
-    targets = np.arange(time[0], time[-1] + 0.5 * step, step) if span > 0 else time[:1]
-    idx = np.clip(np.searchsorted(time, targets), 0, time.size - 1)
-    return np.unique(idx)[:max_frames]
+    rate, pace = _gif_rate(fps, gif), speed
+    if span > 0 and span * rate / pace + 1 > max_frames:
+        low = max(min(MIN_FPS, fps), (max_frames - 1) * pace / span)
+        rate = 100.0 / math.ceil(100.0 / low) if gif else low
+        if span * rate / pace + 1 > max_frames + 1e-9:
+            pace = span * rate / max(max_frames - 1, 1)
+    if span <= 0:
+        return Playback(np.array([0]), rate, pace, speed)
+    step = pace / rate
+    slack = 0.5 * float(np.median(np.diff(time))) if time.size > 1 else 0.0  # the last frame's time jitter
+    targets = time[0] + step * np.arange(min(int(math.floor((span + slack) / step)) + 1, max_frames))
+    right = np.clip(np.searchsorted(time, targets), 1, time.size - 1)
+    nearest = np.where(np.abs(time[right - 1] - targets) <= np.abs(time[right] - targets), right - 1, right)
+    return Playback(np.unique(nearest)[:max_frames], rate, pace, speed)
+
+
+def frame_indices(time: np.ndarray, *, fps: float, speed: float, max_frames: int) -> np.ndarray:
+    """Recorded frames to show (:func:`playback`'s frames)."""
+    return playback(time, fps=fps, speed=speed, max_frames=max_frames).frames
 
 
 def _magnified_rotations(q: np.ndarray, q0: np.ndarray, magnify: float) -> np.ndarray:
@@ -136,9 +200,11 @@ def _failed_points(ds: xr.Dataset, t: float, r: np.ndarray, x: np.ndarray) -> di
     return out
 
 
-def _title(ds: xr.Dataset, frame: int, magnify: float) -> str:
+def _title(ds: xr.Dataset, frame: int, magnify: float, speed: float = 1.0) -> str:
     t = float(ds.time.values[frame])
     text = f"t = {t:.2f} s"
+    if abs(speed - 1.0) > 1e-9:
+        text += f" ({speed:.2g}x real time)"
     if magnify != 1.0:
         text += f", motion x{magnify:g}"
     ften, fsh = int(ds.contacts_failed_tension.values[frame]), int(ds.contacts_failed_shear.values[frame])
@@ -210,9 +276,10 @@ def render_frames(
     magnify: float = 1.0,
     fps: float = 20.0,
     speed: float = 1.0,
-    max_frames: int = 200,
-    size: tuple[float, float] = (6.0, 4.5),
-    dpi: float = 80.0,
+    max_frames: int = 300,
+    size: tuple[float, float] = (6.4, 4.8),
+    dpi: float = 100.0,
+    gif: bool = False,
 ) -> list[np.ndarray]:
     """Render the shown frames as RGB images (H, W, 3) uint8.
 
@@ -221,8 +288,10 @@ def render_frames(
         view: a name of :data:`VIEWS` or (elevation, azimuth) [deg].
         magnify: factor on displacements and rotations since t = 0 [-].
         fps: frames per second of playback; speed: simulated seconds per playback second.
-        max_frames: cap on the number of frames (the stride grows to fit).
-        size: figure size [in]; dpi: pixels per inch.
+        max_frames: cap on the number of frames (see :func:`playback`: the rate drops, then the
+            speed rises to fit, said in the titles).
+        size: figure size [in]; dpi: pixels per inch (default 640 x 480 pixels).
+        gif: frame rate rounded to whole 1/100 s delays (as a GIF stores them).
     """
     ds = load_result(result)
     if isinstance(view, str):
@@ -233,12 +302,13 @@ def render_frames(
         cam = (float(view[0]), float(view[1]))
     if not (np.isfinite(magnify) and magnify > 0):
         raise ValueError(f"magnify must be a positive factor, got {magnify!r}")
-    frames = frame_indices(ds.time.values, fps=fps, speed=speed, max_frames=max_frames)
+    play = playback(ds.time.values, fps=fps, speed=speed, max_frames=max_frames, gif=gif)
+    frames = play.frames
     lo, hi = _bounds(ds, frames, magnify)
     faces, owner = _faces(ds)
     colors = _block_colors(ds)
     images = []
-    with rc_context(STYLE):
+    with rc_context(ANIMATION_STYLE):
         for f in frames:
             fig = Figure(figsize=size, dpi=dpi)
             canvas = FigureCanvasAgg(fig)
@@ -248,44 +318,55 @@ def render_frames(
             else:
                 ax = fig.add_subplot(projection="3d")
                 _draw_3d(ax, ds, int(f), magnify, cam, lo, hi, faces, owner, colors)
-            ax.set_title(_title(ds, int(f), magnify))
+            ax.set_title(_title(ds, int(f), magnify, play.speed))
             if ax.get_legend_handles_labels()[0]:
-                ax.legend(loc="upper right", fontsize=7)
+                ax.legend(loc="upper right", fontsize=9)
             canvas.draw()
             images.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())
     return images
 
 
 def _ffmpeg() -> str:
-    exe = shutil.which("ffmpeg")
-    if exe is None:
-        raise ValueError(
-            "output .mp4 needs the ffmpeg program, which is not on PATH; install ffmpeg "
-            "(e.g. apt-get install ffmpeg or conda install ffmpeg) or write a .gif instead"
-        )
-    return exe
+    """The ffmpeg binary of imageio-ffmpeg (a pip dependency of rockdem; ``IMAGEIO_FFMPEG_EXE``
+    chooses another)."""
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        raise ValueError("output .mp4 needs the imageio-ffmpeg package (pip install imageio-ffmpeg, a rockdem "
+                         "dependency: reinstall rockdem) or write a .gif instead") from None
+    try:
+        return str(imageio_ffmpeg.get_ffmpeg_exe())
+    except RuntimeError as exc:
+        raise ValueError(f"output .mp4: imageio-ffmpeg found no ffmpeg binary ({exc}); write a .gif instead") from None
 
 
 def _write_gif(images: Sequence[np.ndarray], path: Path, fps: float) -> None:
     from PIL import Image
 
     frames = [Image.fromarray(im).convert("P", palette=Image.Palette.ADAPTIVE, colors=255) for im in images]
-    frames[0].save(path, save_all=True, append_images=frames[1:], duration=round(1000.0 / fps), loop=0)
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=10 * round(100.0 / fps), loop=0)
 
 
-def _write_mp4(images: Sequence[np.ndarray], path: Path, fps: float, exe: str) -> None:
+def _write_mp4(images: Sequence[np.ndarray], path: Path, fps: float) -> None:
+    import imageio_ffmpeg
+
     h, w = images[0].shape[:2]
-    cmd = [
-        exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{w}x{h}", "-r", f"{fps:g}",
-        "-i", "-", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p", "-vcodec", "libx264", str(path),
-    ]
-    proc = subprocess.run(cmd, input=b"".join(im.tobytes() for im in images), capture_output=True)
-    if proc.returncode != 0:
-        raise ValueError(f"ffmpeg failed writing {path}: {proc.stderr.decode(errors='replace').strip()}")
+    pad = ((0, h % 2), (0, w % 2), (0, 0))  # H.264 in yuv420p needs even sizes
+    writer = imageio_ffmpeg.write_frames(
+        str(path), (w + w % 2, h + h % 2), fps=fps, codec="libx264", pix_fmt_in="rgb24", pix_fmt_out="yuv420p",
+        macro_block_size=1, ffmpeg_log_level="error", output_params=["-movflags", "+faststart"],
+    )
+    try:
+        writer.send(None)
+        for im in images:
+            writer.send(np.ascontiguousarray(np.pad(im, pad, mode="edge")))
+        writer.close()
+    except (OSError, RuntimeError) as exc:
+        raise ValueError(f"ffmpeg failed writing {path}: {exc}") from None
 
 
 def animate(result: Result, path: str | Path, *, fps: float = 20.0, **options: object) -> Path:
-    """Write an animation of the blocks' motion to ``path`` (.gif, or .mp4 when ffmpeg is present).
+    """Write an animation of the blocks' motion to ``path`` (.gif, or .mp4 through imageio-ffmpeg).
 
     Args:
         result: a result or its NetCDF path.
@@ -300,13 +381,18 @@ def animate(result: Result, path: str | Path, *, fps: float = 20.0, **options: o
     suffix = p.suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"output {p}: the suffix must be .gif or .mp4")
-    exe = _ffmpeg() if suffix == ".mp4" else ""  # fail before rendering
-    images = render_frames(result, fps=fps, **options)  # type: ignore[arg-type]
+    if suffix == ".mp4":
+        _ffmpeg()  # fail before rendering
+    gif = suffix == ".gif"
+    images = render_frames(result, fps=fps, gif=gif, **options)  # type: ignore[arg-type]
+    speed, max_frames = options.get("speed", 1.0), options.get("max_frames", 300)
+    play = playback(load_result(result).time.values, fps=fps, speed=float(speed),  # type: ignore[arg-type]
+                    max_frames=int(max_frames), gif=gif)  # type: ignore[call-overload]
     p.parent.mkdir(parents=True, exist_ok=True)
-    if suffix == ".gif":
-        _write_gif(images, p, fps)
+    if gif:
+        _write_gif(images, p, play.fps)
     else:
-        _write_mp4(images, p, fps, exe)
+        _write_mp4(images, p, play.fps)
     return p
 
 
@@ -329,8 +415,9 @@ def _animate(args: argparse.Namespace) -> int:
     if out.suffix.lower() not in (".gif", ".mp4"):
         raise ValueError(f"-o {out}: the suffix must be .gif or .mp4")
     w, h = args.size
+    ds = read_result_file(args.result)
     p = animate(
-        read_result_file(args.result),
+        ds,
         out,
         fps=args.fps,
         view=args.view,
@@ -340,20 +427,23 @@ def _animate(args: argparse.Namespace) -> int:
         size=(w / args.dpi, h / args.dpi),
         dpi=args.dpi,
     )
-    print(f"rockdem animate: wrote {p}")
+    play = playback(ds.time.values, fps=args.fps, speed=args.speed, max_frames=args.max_frames,
+                    gif=out.suffix.lower() == ".gif")
+    print(f"rockdem animate: wrote {p}: {play.note()}")
     return 0
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``animate`` sub-command."""
-    p = subparsers.add_parser("animate", help="animate the blocks of a result (GIF, MP4 with ffmpeg)")
+    p = subparsers.add_parser("animate", help="animate the blocks of a result (GIF or MP4, real time by default)")
     p.add_argument("result", metavar="RESULT.nc", help="a result written by rockdem run")
     p.add_argument("-o", "--output", help="output .gif or .mp4 (default RESULT.gif)")
     p.add_argument("--view", type=_view_arg, default="iso", help=f"{', '.join(VIEWS)} or ELEV,AZIM [deg] (default iso)")
     p.add_argument("--magnify", type=positive_float, default=1.0, help="factor on displacements and rotations (default 1)")
     p.add_argument("--fps", type=positive_float, default=20.0, help="frames per second (default 20)")
     p.add_argument("--speed", type=positive_float, default=1.0, help="simulated seconds per playback second (default 1)")
-    p.add_argument("--max-frames", type=positive_int, default=200, help="most frames (default 200)")
-    p.add_argument("--size", type=integer_at_least(16), nargs=2, default=(480, 360), metavar=("W", "H"), help="pixels (default 480 360)")
-    p.add_argument("--dpi", type=positive_float, default=80.0, help="pixels per inch of the text (default 80)")
+    p.add_argument("--max-frames", type=positive_int, default=300,
+                   help=f"most frames (default 300): beyond, the rate drops to {MIN_FPS:g} fps, then the playback speeds up (said)")
+    p.add_argument("--size", type=integer_at_least(16), nargs=2, default=(640, 480), metavar=("W", "H"), help="pixels (default 640 480)")
+    p.add_argument("--dpi", type=positive_float, default=100.0, help="pixels per inch of the text (default 100)")
     p.set_defaults(func=_animate)

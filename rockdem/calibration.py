@@ -29,7 +29,8 @@ import pandas as pd
 
 from .analysis import wme
 from .plots import save_figure
-from .studies import RunSpec, execute, resolve_base, run_spec
+from .batch import batch_row
+from .studies import RunSpec, execute, resolve_base, with_stop
 
 __all__ = ["Reference", "load_reference", "reference_from_row", "CalibrationResult", "calibrate", "wme_of_row", "register_cli"]
 
@@ -156,6 +157,7 @@ def calibrate(
     workers: int | None = None,
     scheduler: Any = None,
     store: Any = None,
+    stop: str = "rest",
 ) -> CalibrationResult:
     """Find the parameter value(s) minimising WME(reference, simulation).
 
@@ -175,6 +177,10 @@ def calibrate(
         executor, workers, scheduler: how the scan and curve runs execute (see
             :func:`rockdem.studies.execute`); optimiser steps run one by one in this process.
         store: optional store, so that a repeated calibration reuses finished runs.
+        stop: the runs' ``run.stop`` (:mod:`rockdem.stopping`) unless ``fixed`` sets it: "rest"
+            (default) ends a run once it is at rest after its input and continues its history at
+            rest to the duration, so that it compares with the reference; "off" runs to the end.
+            (Not "decided": a run stopped as collapsed has no history to compare after the stop.)
     """
     from scipy.optimize import minimize, minimize_scalar
 
@@ -185,6 +191,9 @@ def calibrate(
     if log and any(b[0] <= 0 for b in bnds):
         raise ValueError("log search needs positive bounds (use log=False for a parameter that may be 0)")
     base_d = resolve_base(base)
+    if stop not in ("rest", "off"):
+        raise ValueError(f"calibrate: stop must be 'rest' or 'off', got {stop!r} (a run stopped as collapsed has no history to compare)")
+    fixed = with_stop(fixed, stop)
     dur = float(duration) if duration is not None else float(reference.time[-1])
     evals: list[dict[str, Any]] = []
     cache: dict[str, float] = {}
@@ -220,7 +229,7 @@ def calibrate(
         v = [min(max(vi, b[0]), b[1]) for vi, b in zip(v, bnds)]
         s = spec(v)
         if s.id not in cache:
-            record(s, run_spec(s), v)
+            record(s, batch_row(s), v)
         return cache[s.id]
 
     lo, hi = to_x([b[0] for b in bnds]), to_x([b[1] for b in bnds])
@@ -326,7 +335,7 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
             fixed[k.strip()] = v
     res = calibrate(args.base, args.parameter, args.bounds, ref, fixed=fixed, duration=args.duration,
                     log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
-                    workers=args.workers, scheduler=args.scheduler)
+                    workers=args.workers, scheduler=args.scheduler, stop=args.stop)
     print(res.report())
     if args.out:
         out = Path(args.out)
@@ -352,6 +361,8 @@ def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable
     p.add_argument("--duration", type=float, default=None, help="simulated time [s] (default: the reference's)")
     p.add_argument("--linear", action="store_true", help="search in the parameter itself, not its log")
     p.add_argument("--scan", type=int, default=9, help="coarse scan points before the bounded search")
+    p.add_argument("--stop", choices=("rest", "off"), default="rest",
+                   help="end each run once it is at rest after its input (default; its history is continued at rest) or run it to the end")
     p.add_argument("--out", "-o", default=None, help="folder for report.txt, curve.csv, wme.png")
     add_exec_args(p)
     p.set_defaults(func=_calibrate_cli)

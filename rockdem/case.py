@@ -9,8 +9,10 @@ in :data:`LOADINGS`. Units: SI, angles in degrees where the key says ``_deg``.
 from __future__ import annotations
 
 import copy
+import json
 import math
 import os
+import threading
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -20,12 +22,13 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
-from .beta_choice import BETA_AUTO, BETA_MODES
+from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
 from .geometry import MAX_FACE_POINTS
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
+from .stopping import STOP_MODES
 
 __all__ = [
     "Table",
@@ -35,6 +38,9 @@ __all__ = [
     "LOADINGS",
     "load_case",
     "parse_case",
+    "CaseTemplate",
+    "template_key",
+    "SWAPPABLE_LOADINGS",
     "example_names",
     "example_case",
     "apply_overrides",
@@ -219,9 +225,11 @@ class RunOptions:
     resolution: float = 0.3
     record_interval: float = 0.002
     contact_tolerance: float | None = None
+    contact_interval: float | None = None
+    stop: str = "off"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Case:
     """A built case: the model, run options, monitors and output settings, plus what the loading
     adds to the result: ``attrs`` (scalars, e.g. the pushover ramp, the record and its PGA, the tilt
@@ -235,6 +243,17 @@ class Case:
     data: dict[str, Any]
     attrs: dict[str, Any] = field(default_factory=dict)
     series: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        model = repr(self.model).split("\n", 1)[1]
+        return f"rockdem Case {self.name!r}: {run}, monitors {sorted(self.monitors)}\n{model}"
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        run = f"duration {self.run.duration:g} s, frames every {self.run.record_interval:g} s"
+        return f"<b>rockdem Case {escape(self.name)}</b>: {escape(run)}<br>{self.model._repr_html_()}"
 
 
 SpecimenBuilder = Callable[[Table, ModelBuilder], dict[str, Monitor]]
@@ -457,11 +476,7 @@ def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, 
     return out
 
 
-def parse_case(data: Mapping[str, Any]) -> Case:
-    """Validate a case dict and build its model."""
-    top = Table(data, "case")
-    name = top.string("name", "case")
-    top.string("description", "")
+def _run_options(top: Table) -> RunOptions:
     run_t = top.sub("run")
     run = RunOptions(
         duration=run_t.number("duration", positive=True),
@@ -471,15 +486,25 @@ def parse_case(data: Mapping[str, Any]) -> Case:
         resolution=run_t.number("resolution", 0.3, positive=True),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
+        contact_interval=run_t.optional_number("contact_interval", positive=True),
+        stop=run_t.string("stop", "off", choices=STOP_MODES),
     )
     run_t.finish()
-    damping = _damping(top.sub("damping"))
+    return run
+
+
+def _specimen(top: Table) -> tuple[ModelBuilder, dict[str, Monitor]]:
     spec_t = top.sub("specimen")
     kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
     grav = spec_t.number("gravity", 9.81, min_=0.0)
     builder = ModelBuilder(gravity=(0.0, 0.0, -grav))
     monitors = SPECIMENS[kind](spec_t, builder)
     spec_t.finish()
+    return builder, monitors
+
+
+def _loading(top: Table, builder: ModelBuilder, monitors: dict[str, Monitor], run: RunOptions) -> dict[str, Any]:
+    """Apply ``[loading]`` to the builder; returns the context (attrs, series, rocking_axis)."""
     load_t = top.sub("loading")
     lkind = load_t.string("type", "gravity", choices=tuple(sorted(LOADINGS)))
     ctx: dict[str, Any] = {"run": run, "attrs": {"loading": lkind}, "series": {}}
@@ -488,20 +513,124 @@ def parse_case(data: Mapping[str, Any]) -> Case:
     pga = ctx["attrs"].get("earthquake_pga_m_s2")
     if isinstance(pga, float) and "pga_g" not in load_t.data:  # a record scaled by ``scale``
         check_plausible(float(f"{pga / STANDARD_GRAVITY:.4g}"), "[loading] the scaled record's peak ground acceleration [g] (see scale)", "pga_g")
+    return ctx
+
+
+def _output(top: Table) -> dict[str, Any]:
     out_t = top.sub("output")
     output = {
         "directory": out_t.string("directory", ""),
         "plot": out_t.boolean("plot", True),
         "csv": out_t.boolean("csv", True),
+        "checkpoint": out_t.boolean("checkpoint", True),
+        "checkpoint_every": out_t.optional_number("checkpoint_every", positive=True),
+        "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
-    top.finish()
-    model = builder.finalize(
-        damping=damping,
-        rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
-        contact_tolerance=run.contact_tolerance,
-    )
-    return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+    return output
+
+
+def parse_case(data: Mapping[str, Any]) -> Case:
+    """Validate a case dict and build its model."""
+    return CaseTemplate(data).case
+
+
+SWAPPABLE_LOADINGS = ("earthquake",)
+"""Loading types that only set a model's prescribed kinematics (ground motion, body acceleration),
+so that a :class:`CaseTemplate` swaps them without rebuilding the geometry."""
+
+
+def template_key(data: Mapping[str, Any]) -> str:
+    """Cases with equal keys have the same model geometry, materials and initial pose: the
+    ``[specimen]`` table, ``run.contact_tolerance`` and, unless its type is one of
+    :data:`SWAPPABLE_LOADINGS`, the ``[loading]`` table (damping and run options are swapped)."""
+    data = Table(data, "case").data  # a mapping, or the error a case file gets
+    load = data.get("loading", {})
+    swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
+    run = data.get("run", {})
+    key = {
+        "specimen": data.get("specimen"),
+        "contact_tolerance": run.get("contact_tolerance") if isinstance(run, Mapping) else None,
+        "loading": {"type": load.get("type")} if swap else load,
+    }
+    return json.dumps(key, sort_keys=True, separators=(",", ":"), default=str)
+
+
+class CaseTemplate:
+    """A parsed case whose model is reused by cases that differ only in damping, run options,
+    output and, for a swappable loading (:data:`SWAPPABLE_LOADINGS`), the loading itself (another
+    record, scale or PGA): :meth:`derive` validates such a case as :func:`parse_case` does and
+    swaps the new damping and input arrays into the model (:meth:`rockdem.model.Model.with_inputs`)
+    without rebuilding blocks, interface points or the contact geometry. The models are the ones
+    :func:`parse_case` builds, array for array. An automatic beta (``beta = "auto"`` or
+    ``"critical"``, :mod:`rockdem.targeting`) is resolved once per distinct ``[damping]`` table and
+    kept: it depends on the specimen and the damping options, not on the record or its scale.
+
+    Attributes:
+        key: :func:`template_key` of the cases it serves.
+        case: the parsed case of ``data``.
+    """
+
+    def __init__(self, data: Mapping[str, Any]) -> None:
+        top = Table(data, "case")
+        self.key = template_key(data)
+        name = top.string("name", "case")
+        top.string("description", "")
+        run = _run_options(top)
+        damping = _damping(top.sub("damping"))
+        builder, monitors = _specimen(top)
+        load = top.data.get("loading", {})
+        self._swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
+        self._bare = copy.copy(builder) if self._swap else None  # before the loading
+        self._monitors = dict(monitors)
+        ctx = _loading(top, builder, monitors, run)
+        output = _output(top)
+        top.finish()
+        model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
+                                 contact_tolerance=run.contact_tolerance)
+        self._ctx = ctx
+        self._builder = builder  # what an automatic beta is resolved on
+        self._choices: dict[Damping, BetaChoice] = {damping: model.beta_choice} if model.beta_choice is not None else {}
+        self._lock = threading.Lock()  # Dask workers may derive in threads: one search per damping
+        self.case = Case(name, model, run, dict(monitors), output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+    def beta_choice(self, damping: Damping) -> BetaChoice | None:
+        """The resolution of ``damping``'s automatic beta on this template's model (the search runs
+        once per distinct damping; :func:`rockdem.targeting.choose_beta`), None for a numeric beta."""
+        if damping.beta_mode is None:
+            return None
+        with self._lock:
+            choice = self._choices.get(damping)
+            if choice is None:
+                from .targeting import choose_beta  # runs simulations (imports simulate)
+
+                choice = self._choices[damping] = choose_beta(self._builder, self.case.model, damping)
+        return choice
+
+    def derive(self, data: Mapping[str, Any]) -> Case:
+        """The case of ``data`` (same :func:`template_key`), built on this template's model."""
+        top = Table(data, "case")
+        if template_key(data) != self.key:
+            raise ValueError("CaseTemplate.derive: the case's specimen or loading differs from the template's")
+        name = top.string("name", "case")
+        top.string("description", "")
+        run = _run_options(top)
+        damping = _damping(top.sub("damping"))
+        top.used.add("specimen")  # equal to the template's (the key)
+        model = self.case.model
+        if self._swap:
+            builder, monitors = copy.copy(self._bare), dict(self._monitors)
+            ctx = _loading(top, builder, monitors, run)
+            if tuple(ctx.get("rocking_axis", (0.0, 1.0, 0.0))) != tuple(self._ctx.get("rocking_axis", (0.0, 1.0, 0.0))):
+                raise ValueError("CaseTemplate.derive: the loading changed the rocking axis")
+            model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
+        else:
+            top.used.add("loading")
+            ctx, monitors = self._ctx, dict(self.case.monitors)
+            model = model.with_inputs(damping=damping, beta_choice=self.beta_choice(damping))
+        output = _output(top)
+        top.finish()
+        return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
 
 
 _AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")

@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator
 # Modules that contribute a sub-command through ``register_cli(subparsers)``.
 _COMMAND_MODULES = (
     "rockdem.run_cli",
+    "rockdem.preview",
     "rockdem.records",
     "rockdem.advisor",
     "rockdem.plots",

@@ -1,13 +1,20 @@
 """Incremental dynamic analysis (IDA) and lognormal fragility curves.
 
 Each record of a set is scaled to a range of peak ground accelerations (PGA [g]); each (record,
-PGA) pair is a :class:`rockdem.studies.RunSpec` run through the study executors and store. A run
-fails (collapse) when the block overturns or when its peak rotation exceeds ``drift_limit`` x eta
-(eta = slenderness angle). Only runs that finished (status "ok") have an outcome: runs that
-raised an error (e.g. an unreadable record) or diverged are counted apart and never enter a fit. The fragility P(fail | PGA) = Phi(ln(PGA / theta) / beta) is fitted by
-maximum likelihood: on (PGA, failed) outcomes with a binomial likelihood (Baker 2015), or on the
-per-record collapse capacities of an IDA (lognormal MLE: theta = exp(mean ln IM), beta = std ln IM
-with ddof = 0).
+PGA) pair is a :class:`rockdem.studies.RunSpec` run through the study executors (batch path) and
+store, by default stopping each run once its outcome is decided (``run.stop = "decided"``,
+:mod:`rockdem.stopping`). A run fails (collapse) when the block overturns, when it stopped because
+it collapsed, or when its peak rotation exceeds ``drift_limit`` x eta (eta = slenderness angle).
+Only runs that finished (status "ok") have an outcome: runs that raised an error (e.g. an
+unreadable record) or diverged are counted apart and never enter a fit.
+
+Every run's input gets its intensity measures (:mod:`rockdem.intensity`: PGV, Arias intensity,
+Sa(T) at the block's characteristic period, beside the PGA), and the fragility
+P(fail | IM) = Phi(ln(IM / theta) / beta) is fitted against each of them by maximum likelihood: on
+(IM, failed) outcomes with a binomial likelihood (Baker 2015), or on the per-record collapse
+capacities of an IDA (lognormal MLE: theta = exp(mean ln IM), beta = std ln IM with ddof = 0).
+``run_ida`` writes the table, the fits (``fragility.csv``), the IDA curves, the fragility curves,
+the input spectra and a ``report.md`` that shows them.
 """
 
 from __future__ import annotations
@@ -24,8 +31,12 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.stats import norm
 
+from .intensity import IM_COLUMNS, response_spectrum, rocking_period, spec_intensities
+from .loading import earthquake_record
 from .plots import save_figure
-from .studies import RunSpec, Store, execute, resolve_base, save_table, study_table
+from .records import STANDARD_GRAVITY
+from .stopping import STOP_MODES
+from .studies import RunSpec, Store, execute, resolve_base, save_table, study_table, with_stop
 
 __all__ = [
     "Fragility",
@@ -40,13 +51,20 @@ __all__ = [
     "collapse_capacities",
     "plot_ida",
     "plot_fragility",
+    "plot_fragility_all",
+    "plot_spectra",
+    "write_report",
+    "fit_all",
+    "add_intensities",
+    "COLLAPSE_REASONS",
     "register_cli",
 ]
 
 
 @dataclass(frozen=True)
 class Fragility:
-    """Lognormal fragility: median ``theta`` [g] and dispersion ``beta`` [-]."""
+    """Lognormal fragility: median ``theta`` (in the unit of its intensity measure, [g] for PGA)
+    and dispersion ``beta`` [-]."""
 
     theta: float
     beta: float
@@ -100,9 +118,11 @@ def fit_fragility_capacities(capacities: Sequence[float]) -> Fragility:
 
 
 def ida_specs(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], *,
-              fixed: Mapping[str, Any] | None = None, duration: float | None = None) -> list[RunSpec]:
-    """One spec per (record, PGA [g])."""
+              fixed: Mapping[str, Any] | None = None, duration: float | None = None, stop: str = "decided") -> list[RunSpec]:
+    """One spec per (record, PGA [g]); ``stop`` is the runs' ``run.stop`` (:mod:`rockdem.stopping`)
+    unless ``fixed`` sets it."""
     b = resolve_base(base)
+    fixed = with_stop(fixed, stop)
     return [RunSpec.make(b, fixed, duration=duration, record=str(r), pga_g=float(a)) for r in records for a in pga_g]
 
 
@@ -113,14 +133,21 @@ def completed(table: pd.DataFrame) -> pd.Series:
     return table["status"].eq("ok")
 
 
+COLLAPSE_REASONS = ("overturned", "fell")
+"""``stop_reason`` values of runs stopped because they collapsed."""
+
+
 def failed(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
-    """Failure of each run: overturned, or peak rotation > drift_limit x eta (a nullable boolean:
-    <NA> for runs without an outcome, see :func:`completed`)."""
+    """Failure of each run: overturned, stopped because it collapsed (``stop_reason``), or peak
+    rotation > drift_limit x eta (a nullable boolean: <NA> for runs without an outcome, see
+    :func:`completed`)."""
     done = completed(table)
     f = pd.Series(pd.NA, index=table.index, dtype="boolean")
     if done.any():
         sub = table[done]
         g = sub["overturned"].astype(bool)
+        if "stop_reason" in sub:
+            g = g | sub["stop_reason"].isin(COLLAPSE_REASONS)
         if drift_limit is not None:
             g = g | (sub["max_rotation_over_eta"].astype(float) > drift_limit)
         f[done] = g.to_numpy()
@@ -162,36 +189,96 @@ def collapse_capacities(table: pd.DataFrame, drift_limit: float | None = None) -
     return t[t.failed.astype(bool)].groupby("record")["pga_g"].min().reindex(sorted(t["record"].unique()))
 
 
+def add_intensities(table: pd.DataFrame, specs: Sequence[RunSpec], period: float | None) -> pd.DataFrame:
+    """The table with the IM columns of each run's input (:data:`rockdem.intensity.IM_COLUMNS`
+    besides ``pga_g``, and ``sa_period_s``); ``period`` None: no Sa column."""
+    if period is None:
+        return table
+    ims = spec_intensities(specs, period)
+    col = {name: table["id"].map(lambda i, n=name: getattr(ims.get(i), n, np.nan) if ims.get(i) else np.nan)
+           for name in ("pgv_m_s", "arias_m_s", "sa_g")}
+    return table.assign(**col, sa_period_s=period)
+
+
+def fit_all(table: pd.DataFrame) -> pd.DataFrame:
+    """Binomial MLE fragility against every IM column present (:data:`rockdem.intensity.IM_COLUMNS`)
+    over the completed runs: columns ``im``, ``label``, ``theta``, ``beta``, ``n`` (NaN where the
+    runs do not have both failures and survivals)."""
+    done = table[completed(table)]
+    rows = []
+    for im, label in IM_COLUMNS.items():
+        if im not in done or done[im].isna().all():
+            continue
+        sub = done[done[im].notna() & (done[im] > 0)]
+        try:
+            f = fit_fragility_mle(sub[im].astype(float), sub["failed"].astype(int))
+            rows.append({"im": im, "label": label, "theta": f.theta, "beta": f.beta, "n": f.n})
+        except ValueError:
+            rows.append({"im": im, "label": label, "theta": np.nan, "beta": np.nan, "n": len(sub)})
+    return pd.DataFrame(rows, columns=["im", "label", "theta", "beta", "n"])
+
+
+def characteristic_period(specs: Sequence[RunSpec]) -> float | None:
+    """The rocking period T = 2 pi / p of the first spec's first free block (None without one)."""
+    from .batch import case_of
+
+    try:
+        return rocking_period(case_of(specs[0].case_dict()).model)
+    except (ValueError, FileNotFoundError, IndexError):
+        return None
+
+
 def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], out: str | os.PathLike[str], *,
             fixed: Mapping[str, Any] | None = None, duration: float | None = None, drift_limit: float | None = None,
-            executor: str = "process", workers: int | None = None, scheduler: Any = None,
-            progress: bool = True) -> tuple[pd.DataFrame, Fragility | None]:
-    """Run an IDA into folder ``out`` (store, table, plots) and fit the fragility (None if it cannot).
+            im: str = "pga_g", period: float | None = None, stop: str = "decided", executor: str = "process",
+            workers: int | None = None, scheduler: Any = None, progress: bool = True,
+            batch: bool = True) -> tuple[pd.DataFrame, Fragility | None]:
+    """Run an IDA into folder ``out`` and fit the fragility against ``im`` (None if it cannot).
 
-    The table's ``failed`` column is empty for runs without an outcome (errors, divergence); only
-    the completed runs enter the fit and the plots.
+    Writes ``table.csv`` (one row per run, with the IM columns), ``fragility.csv`` (the fit against
+    every IM), ``ida.png``, ``fragility.png``, ``spectra.png`` and ``report.md``. The table's
+    ``failed`` column is empty for runs without an outcome (errors, divergence); only the
+    completed runs enter the fits.
+
+    Args:
+        im: the intensity measure of the returned fit and of the IDA plot's axis
+            (:data:`rockdem.intensity.IM_COLUMNS`).
+        period: spectral period of Sa [s]; default the block's rocking period 2 pi / p.
+        stop: ``run.stop`` of the runs (:mod:`rockdem.stopping`): "decided" (default) stops a run
+            once it has collapsed (or is at rest after the record); "off" runs every record to its end.
+        batch: the batch path (identical rows, faster); False runs each spec as a single run.
 
     Raises:
-        ValueError: no run completed (the table is written first; the message gives the first error).
+        ValueError: an unknown ``im``, or no run completed (the table is written first; the
+            message gives the first error).
     """
-    specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration)
+    if im not in IM_COLUMNS:
+        raise ValueError(f"im must be one of {list(IM_COLUMNS)}, got {im!r}")
+    if period is not None and not (np.isfinite(period) and period > 0):
+        raise ValueError(f"period must be a positive time [s], got {period!r}")
+    specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration, stop=stop)
     store = Store(out)
-    execute(specs, store, executor=executor, workers=workers, scheduler=scheduler, progress=progress)
+    execute(specs, store, executor=executor, workers=workers, scheduler=scheduler, progress=progress, batch=batch)
     df = study_table(store, specs=specs)
     df = df.assign(failed=failed(df, drift_limit))
+    t_p = period if period is not None else characteristic_period(specs)
+    df = add_intensities(df, specs, t_p)
     save_table(df, out)
     done = df[completed(df)]
     if done.empty:
         first = df["error"].dropna().iloc[0] if "error" in df and df["error"].notna().any() else "no error message"
         raise ValueError(f"none of the {len(df)} IDA runs completed ({ida_counts(df).line()}), so there is no "
                          f"fragility; first error: {first}. See {Path(out) / 'table.csv'}")
-    try:
-        frag = fit_fragility_mle(done["pga_g"], done["failed"].astype(int))
-    except ValueError:
-        frag = None
-    plot_ida(done, Path(out) / "ida.png", drift_limit=drift_limit)
-    if frag is not None:
-        plot_fragility(frag, done, Path(out) / "fragility.png")
+    if im not in df or df[im].isna().all():
+        raise ValueError(f"no {IM_COLUMNS[im]} for these runs (the Sa period is unknown: give period=)")
+    fits = fit_all(df)
+    fits.to_csv(Path(out) / "fragility.csv", index=False)
+    chosen = fits[fits["im"] == im].iloc[0]
+    frag = None if not np.isfinite(chosen["theta"]) else Fragility(float(chosen["theta"]), float(chosen["beta"]), int(chosen["n"]))
+    plot_ida(df, Path(out) / "ida.png", drift_limit=drift_limit, im=im)
+    plot_fragility_all(df, fits, Path(out) / "fragility.png")
+    plot_spectra(specs, Path(out) / "spectra.png", period=t_p)
+    write_report(df, fits, Path(out), drift_limit=drift_limit, period=t_p)
     return df, frag
 
 
@@ -204,19 +291,178 @@ def _fig() -> Any:
     return plt
 
 
-def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: float | None = None) -> Path:
-    """IDA curves: PGA [g] against peak rotation / eta, one line per record; failures marked."""
+MARKERS = "osD^v<>ph*"
+LINESTYLES = ("-", "--", "-.", ":")
+
+
+def _style(k: int) -> dict[str, Any]:
+    """Line style of the k-th record: colour, marker and dash pattern all differ between neighbours."""
+    return {"color": f"C{k % 10}", "marker": MARKERS[k % len(MARKERS)], "ls": LINESTYLES[(k // 10) % len(LINESTYLES)]}
+
+
+ROTATION_FLOOR = 1e-3
+"""Smallest peak rotation / eta shown on the IDA plot's log axis (smaller values are drawn there)."""
+
+
+def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: float | None = None,
+             im: str = "pga_g") -> Path:
+    """IDA curves: ``im`` against peak rotation / eta (log axis), one curve per record through its
+    survivals; a strip beside it shows every run's outcome per record at its intensity: survival,
+    collapse (the lowest one marked as the record's capacity), error, divergence. ``table`` is the
+    whole IDA table (with ``failed`` and ``status``)."""
     plt = _fig()
-    fig, ax = plt.subplots(figsize=(6, 4.5))
-    for rec, g in table.sort_values("pga_g").groupby("record"):
-        x = np.minimum(g["max_rotation_over_eta"].astype(float), 1.5)
-        ax.plot(x, g["pga_g"], "-o", ms=3, label=Path(str(rec)).stem)
-        f = failed(g, drift_limit).fillna(False).astype(bool)
-        ax.plot(x[f], g["pga_g"][f], "x", color="k")
+    status = table["status"] if "status" in table else pd.Series("ok", index=table.index)
+    fail = table["failed"].astype("boolean") if "failed" in table else failed(table, drift_limit)
+    recs = sorted(table["record"].astype(str).unique())
+    fig, (ax, strip) = plt.subplots(1, 2, figsize=(9, 5.2), sharey=True, gridspec_kw={"width_ratios": [3.2, 1]}, layout="constrained")
+    y_all = table[im].astype(float)
+    shown: set[str] = set()
+    x_max = 1.0
+    for k, rec in enumerate(recs):
+        g = table[(table["record"].astype(str) == rec)]
+        sty = _style(k)
+        ok = g[status[g.index].eq("ok") & fail[g.index].eq(False)].sort_values(im)
+        x = np.clip(ok["max_rotation_over_eta"].astype(float), ROTATION_FLOOR, None)
+        x_max = max(x_max, float(x.max()) if len(x) else 1.0)
+        ax.plot(x, ok[im], lw=1.2, ms=3.5, alpha=0.85, markevery=max(1, len(ok) // 40), label=Path(rec).stem, **sty)
+        # the strip: one column per record
+        for what, sel, mk, col in (
+            ("survival", status[g.index].eq("ok") & fail[g.index].eq(False), "o", sty["color"]),
+            ("collapse", status[g.index].eq("ok") & fail[g.index].eq(True), "x", "k"),
+            ("error", status[g.index].eq("error"), "^", "r"),
+            ("diverged", status[g.index].eq("diverged"), "D", "m"),
+        ):
+            yy = g.loc[sel, im].astype(float)
+            strip.plot(np.full(len(yy), k), yy, ls="none", marker=mk, ms=4 if mk != "o" else 3, color=col,
+                       mfc="none" if what == "survival" else col, label=what if what not in shown and len(yy) else None)
+            if len(yy):
+                shown.add(what)
+        cap = g.loc[status[g.index].eq("ok") & fail[g.index].eq(True), im].astype(float)
+        if len(cap):
+            strip.plot([k - 0.35, k + 0.35], [cap.min()] * 2, color="k", lw=2)
+            ax.axhline(cap.min(), color=sty["color"], lw=0.6, ls=":", alpha=0.8)
     if drift_limit is not None:
-        ax.axvline(drift_limit, color="r", lw=0.8, ls="--")
-    ax.set_xlabel("peak rotation / eta [-] (capped at 1.5; x = failure)")
-    ax.set_ylabel("PGA [g]")
+        ax.axvline(drift_limit, color="r", lw=0.8, ls="--", label=f"drift limit {drift_limit:g} eta")
+    ax.axvline(1.0, color="0.5", lw=0.6)
+    ax.set_xscale("log")
+    ax.set_xlim(ROTATION_FLOOR * 0.8, 1.5 * x_max)
+    ax.set_xlabel("peak rotation / eta [-] (survivals; dotted: each record's collapse capacity)")
+    ax.set_ylabel(_im_label(table, im))
+    ax.grid(True, which="both", alpha=0.25)
+    ax.legend(fontsize=7, loc="upper left", ncol=1 if len(recs) < 8 else 2)
+    strip.set_xticks(range(len(recs)))
+    strip.set_xticklabels([Path(r).stem for r in recs], rotation=60, ha="right", fontsize=7)
+    strip.set_xlim(-0.6, len(recs) - 0.4)
+    strip.set_title("outcome of every run\n(bar: lowest collapse)", fontsize=8)
+    strip.legend(fontsize=7, loc="upper left", framealpha=0.9)
+    strip.grid(True, axis="y", alpha=0.25)
+    if y_all.notna().any():
+        ax.set_ylim(0.0, float(y_all.max()) * 1.05)
+    fig.suptitle(ida_counts(table.assign(failed=fail)).line(), fontsize=9)
+    p = save_figure(fig, path)
+    plt.close(fig)
+    return p
+
+
+def _im_label(table: pd.DataFrame | None, im: str) -> str:
+    """Axis label of an IM column (Sa with its period)."""
+    if im == "sa_g" and table is not None and "sa_period_s" in table and table["sa_period_s"].notna().any():
+        return f"Sa(T = {float(table['sa_period_s'].dropna().iloc[0]):.3g} s) [g], 5 % damping"
+    return IM_COLUMNS.get(im, im)
+
+
+def _observed(table: pd.DataFrame, im: str, bins: int = 12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Failure fraction of the completed runs in bins of ``im`` of about equal counts: (bin
+    median, fraction, runs)."""
+    done = table[completed(table) & table[im].notna()]
+    x = done[im].astype(float).to_numpy()
+    f = done["failed"].astype(float).to_numpy()
+    levels = np.unique(x)
+    if len(levels) <= bins:
+        edges_idx = [x == v for v in levels]
+    else:
+        edges = np.quantile(x, np.linspace(0, 1, bins + 1))
+        idx = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, bins - 1)
+        edges_idx = [idx == k for k in range(bins)]
+    out = [(float(np.median(x[m])), float(f[m].mean()), int(m.sum())) for m in edges_idx if m.any()]
+    return tuple(np.array(v) for v in zip(*out)) if out else (np.zeros(0), np.zeros(0), np.zeros(0))
+
+
+def plot_fragility(frag: Fragility, table: pd.DataFrame | None, path: str | os.PathLike[str], *, im: str = "pga_g") -> Path:
+    """Fitted fragility curve against ``im`` with the observed failure fraction of the completed runs."""
+    plt = _fig()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    _fragility_axes(ax, frag, table, im)
+    fig.tight_layout()
+    p = save_figure(fig, path)
+    plt.close(fig)
+    return p
+
+
+def _fragility_axes(ax: Any, frag: Fragility | None, table: pd.DataFrame | None, im: str) -> None:
+    hi = float(table[im].max()) * 1.2 if table is not None and im in table and table[im].notna().any() else 3 * (frag.theta if frag else 1.0)
+    if table is not None and "failed" in table and im in table:
+        x, f, n = _observed(table, im)
+        ax.scatter(x, f, s=12 + 40 * n / max(n.max(), 1), color="C1", zorder=3, label="observed fraction (binned)")
+    if frag is not None:
+        xs = np.linspace(hi * 1e-3, hi, 300)
+        ax.plot(xs, frag.probability(xs), color="C0", label=f"theta = {frag.theta:.3g}, beta = {frag.beta:.3g}")
+    else:
+        ax.text(0.5, 0.5, "not fitted\n(no failures or no survivals)", transform=ax.transAxes, ha="center", fontsize=8)
+    ax.set_xlabel(_im_label(table, im))
+    ax.set_ylabel("P(failure)")
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlim(0.0, hi)
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=7, loc="lower right")
+
+
+def plot_fragility_all(table: pd.DataFrame, fits: pd.DataFrame, path: str | os.PathLike[str]) -> Path:
+    """Fragility curves against every fitted IM (one panel each), observed fractions beside."""
+    plt = _fig()
+    n = max(len(fits), 1)
+    cols = 2 if n > 1 else 1
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 3.6 * rows), squeeze=False)
+    for ax, (_, r) in zip(axes.flat, fits.iterrows()):
+        frag = Fragility(float(r["theta"]), float(r["beta"]), int(r["n"])) if np.isfinite(r["theta"]) else None
+        _fragility_axes(ax, frag, table, str(r["im"]))
+    for ax in list(axes.flat)[len(fits):]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    p = save_figure(fig, path)
+    plt.close(fig)
+    return p
+
+
+def plot_spectra(specs: Sequence[RunSpec], path: str | os.PathLike[str], *, period: float | None = None) -> Path | None:
+    """5 %-damped pseudo-acceleration spectra of the IDA's records as applied (processed), each
+    scaled to PGA = 1 g, with the spectral period of Sa marked; None when no record can be read."""
+    plt = _fig()
+    periods = np.geomspace(0.02, 10.0, 160)
+    seen: dict[str, Any] = {}
+    for s in specs:
+        load = s.case_dict().get("loading", {})
+        if load.get("type") != "earthquake" or str(load.get("record")) in seen:
+            continue
+        try:
+            gm = earthquake_record({k: v for k, v in load.items() if k != "scale"} | {"pga_g": 1.0})
+        except (ValueError, FileNotFoundError, OSError):
+            continue
+        seen[str(load["record"])] = gm
+    if not seen:
+        return None
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for k, (rec, gm) in enumerate(sorted(seen.items())):
+        sa = response_spectrum(gm.acceleration, gm.dt, periods) / STANDARD_GRAVITY
+        sty = _style(k)
+        ax.plot(periods, sa, color=sty["color"], ls=sty["ls"], lw=1.3, label=f"{Path(rec).stem} (dt {gm.dt:g} s)")
+    if period is not None:
+        ax.axvline(period, color="k", lw=0.8, ls="--", label=f"T = 2 pi / p = {period:.3g} s")
+    ax.set_xscale("log")
+    ax.set_xlabel("period T [s]")
+    ax.set_ylabel("Sa(T) [g], 5 % damping, record scaled to PGA = 1 g")
+    ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=7)
     fig.tight_layout()
     p = save_figure(fig, path)
@@ -224,23 +470,24 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     return p
 
 
-def plot_fragility(frag: Fragility, table: pd.DataFrame | None, path: str | os.PathLike[str]) -> Path:
-    """Fitted fragility curve with the observed failure fraction per PGA level."""
-    plt = _fig()
-    fig, ax = plt.subplots(figsize=(6, 4))
-    hi = float(table["pga_g"].max()) * 1.2 if table is not None else 3 * frag.theta
-    x = np.linspace(1e-3, hi, 300)
-    ax.plot(x, frag.probability(x), label=f"theta = {frag.theta:.3g} g, beta = {frag.beta:.3g}")
-    if table is not None and "failed" in table:
-        obs = table[completed(table)].assign(failed=lambda t: t["failed"].astype(float)).groupby("pga_g")["failed"].mean()
-        ax.plot(obs.index, obs.values, "o", label="observed fraction")
-    ax.set_xlabel("PGA [g]")
-    ax.set_ylabel("P(failure)")
-    ax.set_ylim(-0.02, 1.02)
-    ax.legend()
-    fig.tight_layout()
-    p = save_figure(fig, path)
-    plt.close(fig)
+def write_report(table: pd.DataFrame, fits: pd.DataFrame, out: Path, *, drift_limit: float | None = None,
+                 period: float | None = None) -> Path:
+    """``report.md``: the counts, the fits against every IM, the period and the figures."""
+    c = ida_counts(table)
+    lines = ["# IDA and fragility", "", f"{c.line()}.", ""]
+    if "stop_reason" in table:
+        reasons = table["stop_reason"].fillna("ran to the end").value_counts()
+        lines += ["Runs stopped once decided: " + ", ".join(f"{n} {r}" for r, n in reasons.items()) + ".", ""]
+    lines += [f"Failure: overturned or collapsed{f', or peak rotation > {drift_limit:g} eta' if drift_limit else ''}.",
+              f"Sa at T = {period:.4g} s (the block's rocking period 2 pi / p unless given), 5 % damping." if period else "",
+              "", "| intensity measure | median theta | dispersion beta | runs |", "| --- | --- | --- | --- |"]
+    for _, r in fits.iterrows():
+        th = f"{r['theta']:.4g}" if np.isfinite(r["theta"]) else "not fitted"
+        be = f"{r['beta']:.3g}" if np.isfinite(r["beta"]) else "-"
+        lines.append(f"| {r['label']} | {th} | {be} | {int(r['n'])} |")
+    lines += ["", "![IDA curves](ida.png)", "", "![fragility curves](fragility.png)", "", "![input spectra](spectra.png)", ""]
+    p = out / "report.md"
+    p.write_text("\n".join(lines))
     return p
 
 
@@ -257,13 +504,14 @@ def _fragility_cli(args: argparse.Namespace) -> int:
     lo, hi, n = args.pga
     levels = np.linspace(float(lo), float(hi), int(n))
     df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,
-                       drift_limit=args.drift_limit, executor=args.executor or "process", workers=args.workers,
+                       drift_limit=args.drift_limit, im=args.im, period=args.period, stop=args.stop,
+                       executor=args.executor or "process", workers=args.workers,
                        scheduler=args.scheduler, progress=not args.no_progress)
-    print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}")
+    print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}, report.md")
     if frag is None:
-        print("fragility: not fitted (every completed run failed, or none did; widen the PGA range)")
+        print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did; widen the PGA range)")
     else:
-        print(f"fragility: median {frag.theta:.4g} g, dispersion {frag.beta:.4g}")
+        print(f"fragility against {IM_COLUMNS[args.im]}: median {frag.theta:.4g}, dispersion {frag.beta:.4g}")
     return 0
 
 
@@ -275,6 +523,9 @@ def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable
     p.add_argument("--pga", nargs=3, default=(0.05, 1.0, 10), metavar=("LOW", "HIGH", "N"), help="PGA levels [g]")
     p.add_argument("--duration", type=float, default=None, help="simulated time [s]")
     p.add_argument("--drift-limit", type=float, default=None, help="failure when peak rotation > this x eta")
+    p.add_argument("--im", choices=tuple(IM_COLUMNS), default="pga_g", help="intensity measure of the printed fit and the IDA plot (all are fitted: fragility.csv)")
+    p.add_argument("--period", type=float, default=None, help="period of Sa [s] (default: the block's rocking period 2 pi / p)")
+    p.add_argument("--stop", choices=STOP_MODES, default="decided", help="end each run once its outcome is decided (default) or run it to the end (off)")
     p.add_argument("--set", action="append", metavar="table.key=value", help="fixed override (repeatable)")
     p.add_argument("--out", "-o", default="ida", help="output folder")
     add_exec_args(p)

@@ -33,7 +33,9 @@ Units: SI (m, s, m/s^2); records are converted once by :mod:`rockdem.records`.
 
 from __future__ import annotations
 
+import functools
 import math
+import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Mapping
@@ -54,6 +56,7 @@ __all__ = [
     "PushoverRamp",
     "resolve_record",
     "prepare_record",
+    "earthquake_record",
     "apply_earthquake",
     "apply_pushover",
     "RodPushover",
@@ -529,20 +532,25 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
 
 
 def _read_table_record(t: Table, key: str, units: str | None, dt: float | None) -> GroundMotion:
-    return read_record(t.string(key), units=units, dt=dt)
+    return _read_cached(str(record_path(t.string(key))), units, dt)
 
 
-@loading("earthquake")
-def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
-    """An earthquake record on the foundation (or as inertial forces), starting from rest.
+def _read_cached(path: str, units: str | None, dt: float | None) -> GroundMotion:
+    """:func:`read_record`, remembered per process by file, size and modification time (a record
+    read for every run of a study is parsed once; an edited file is read again). GroundMotion is
+    immutable, so the runs share it safely."""
+    st = os.stat(path)
+    return _read_record_at(path, st.st_size, st.st_mtime_ns, units, dt)
 
-    Keys: record (a shipped record's short name, e.g. "elcentro-rsn6" (``rockdem records`` lists
-    them), or a file: a path relative to the working folder, or a file name in ``$ROCKDEM_DATA``),
-    units ("g", "m/s2", "cm/s2"; optional for AT2 and shipped records), dt [s] (single-column files), scale (default 1) or pga_g
-    (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
-    the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
-    baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0).
-    """
+
+@functools.lru_cache(maxsize=64)
+def _read_record_at(path: str, size: int, mtime_ns: int, units: str | None, dt: float | None) -> GroundMotion:
+    return read_record(path, units=units, dt=dt)
+
+
+def _earthquake_settings(t: Table) -> dict[str, Any]:
+    """The keys of an ``earthquake`` loading table, read and checked: the record (``motion``) and
+    the :func:`apply_earthquake` options."""
     units = t.raw("units")
     if units is not None and not isinstance(units, str):
         raise ValueError(f"[{t.where}] units must be a string such as \"g\", got {units!r}")
@@ -564,19 +572,45 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
     window = t.raw("window")
     if window is not None:
         window = tuple(t.vector("window", size=2))
-    info = apply_earthquake(
-        b,
-        gm,
-        mode=t.string("mode", "foundation", choices=EARTHQUAKE_MODES),
-        scale=scale,
-        pga=None if pga_g is None else pga_g * STANDARD_GRAVITY,
-        direction=t.vector("direction", (1.0, 0.0, 0.0)),
-        vertical=isinstance(vert, str),
-        baseline=t.boolean("baseline", True),
-        tail=t.number("tail", 0.0, min_=0.0),
-        window=window,  # type: ignore[arg-type]
-        delay=t.number("delay", 0.0, min_=0.0),
-    )
+    return {
+        "motion": gm,
+        "mode": t.string("mode", "foundation", choices=EARTHQUAKE_MODES),
+        "scale": scale,
+        "pga": None if pga_g is None else pga_g * STANDARD_GRAVITY,
+        "direction": t.vector("direction", (1.0, 0.0, 0.0)),
+        "vertical": isinstance(vert, str),
+        "baseline": t.boolean("baseline", True),
+        "tail": t.number("tail", 0.0, min_=0.0),
+        "window": window,
+        "delay": t.number("delay", 0.0, min_=0.0),
+    }
+
+
+def earthquake_record(table: Mapping[str, Any], *, scale: float | None = None) -> GroundMotion:
+    """The record an ``earthquake`` loading table applies, processed as :func:`apply_earthquake`
+    processes it (window, scale or PGA, direction, baseline correction, tail); ``scale`` replaces
+    the table's scale and pga_g (``scale=1``: the record at its own amplitude)."""
+    t = Table(table, "loading")
+    t.string("type", "earthquake")
+    opts = _earthquake_settings(t)
+    if scale is not None:
+        opts["scale"], opts["pga"] = float(scale), None
+    return prepare_record(opts["motion"], scale=opts["scale"], pga=opts["pga"], direction=opts["direction"],
+                          vertical=opts["vertical"], baseline=opts["baseline"], tail=opts["tail"], window=opts["window"])
+
+
+@loading("earthquake")
+def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict[str, Any]) -> None:
+    """An earthquake record on the foundation (or as inertial forces), starting from rest.
+
+    Keys: record (a shipped record's short name, e.g. "elcentro-rsn6" (``rockdem records`` lists
+    them), or a file: a path relative to the working folder, or a file name in ``$ROCKDEM_DATA``),
+    units ("g", "m/s2", "cm/s2"; optional for AT2 and shipped records), dt [s] (single-column files), scale (default 1) or pga_g
+    (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
+    the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
+    baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0).
+    """
+    info = apply_earthquake(b, **_earthquake_settings(t))
     ctx["attrs"].update(
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,

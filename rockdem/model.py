@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass, field, replace
-from typing import Callable, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -210,9 +210,10 @@ class _Block:
     reference: Polyhedron | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Model:
-    """A frozen model: the kernel arrays plus the names and initial state.
+    """A frozen model: the kernel arrays plus the names and initial state (printed as a short
+    summary; a notebook shows it as a table).
 
     Attributes:
         arrays: flat arrays used by the kernels.
@@ -256,6 +257,91 @@ class Model:
     @property
     def point_count(self) -> int:
         return int(self.arrays.point_area.shape[0])
+
+    def with_inputs(
+        self, *, damping: Damping | None = None, builder: ModelBuilder | None = None, beta_choice: BetaChoice | None = None
+    ) -> Model:
+        """This model with another damping and/or the prescribed kinematics (ground motion, body
+        acceleration, driven motions) of ``builder``, whose blocks must be this model's: the
+        geometry is not rebuilt. The arrays are those :meth:`ModelBuilder.finalize` would give.
+
+        A damping whose beta is ``"auto"`` or ``"critical"`` needs ``beta_choice``, its resolution on
+        this model's builder (:func:`rockdem.targeting.choose_beta`; :class:`rockdem.case.CaseTemplate`
+        keeps one per damping); the model then carries the chosen betas as ``finalize`` leaves them.
+        """
+        fields: dict[str, Any] = {}
+        new_damping, choice = self.damping, self.beta_choice
+        if damping is not None:
+            damping.validate()
+            if beta_choice is not None and beta_choice.mode != damping.beta_mode:
+                raise ValueError(f"with_inputs: beta_choice is the resolution of beta = {beta_choice.mode!r}, "
+                                 f"but damping.beta is {damping.beta!r}")
+            if damping.beta_mode is not None and beta_choice is None:
+                raise ValueError(
+                    f"with_inputs: damping.beta = {damping.beta!r} is chosen from the model's builder; pass "
+                    "beta_choice=rockdem.targeting.choose_beta(builder, model, damping) or use ModelBuilder.finalize"
+                )
+            fields.update(damping_arrays(self.materials, self.group_names, damping, beta_choice))
+            new_damping = damping if beta_choice is None else replace(damping, beta=beta_choice.beta)
+            choice = beta_choice
+        elif beta_choice is not None:
+            raise ValueError("with_inputs: beta_choice goes with the damping it resolves (give damping=)")
+        if builder is not None:
+            if tuple(builder.block_names()) != self.block_names:
+                raise ValueError("with_inputs: the builder's blocks are not this model's")
+            fields.update(builder.input_arrays())
+        return replace(self, arrays=self.arrays._replace(**fields), damping=new_damping, beta_choice=choice)
+
+    def summary(self) -> dict[str, str]:
+        """Short description, label -> text: blocks, points, groups, joints, damping, loading, size."""
+        m = self.arrays
+        free = m.block_free.astype(bool)
+        driven = [n for n, f in zip(self.block_names, free) if not f]
+        v = self.arrays.vertex_local
+        owner = np.repeat(np.arange(self.block_count), np.diff(m.block_vertex_start))
+        from .kernels.rotation import quats_to_matrices
+
+        world = np.einsum("vij,vj->vi", quats_to_matrices(self.quaternion0)[owner], v) + self.position0[owner]
+        lo, hi = world[free[owner]].min(axis=0), world[free[owner]].max(axis=0)
+        tiny = 1e-9 * max(float(np.max(hi - lo)), 1e-300)
+        lo, hi = np.where(np.abs(lo) < tiny, 0.0, lo), np.where(np.abs(hi) < tiny, 0.0, hi)
+        kn = sorted({f"{mat.kn:.3g}" for mat in self.materials.values()})
+        phi = sorted({f"{math.degrees(math.atan(mat.tan_friction)):.3g}" for mat in self.materials.values()})
+        loading = []
+        if m.ground_motion >= 0:
+            loading.append(f"ground motion ({m.motion_time[-1]:.3g} s)" if m.motion_time.size else "ground motion")
+        if m.body_time.size:
+            loading.append(f"body acceleration ({m.body_time[-1]:.3g} s)")
+        if np.any(m.block_motion[~free] > (0 if m.ground_motion >= 0 else -1)):
+            loading.append("prescribed motion of driven blocks")
+        tilted = int(np.count_nonzero(np.any(self.quaternion0 != self.quaternion_ref, axis=1)))
+        if tilted:
+            loading.append(f"{tilted} block(s) tilted")
+        d = self.damping
+        return {
+            "blocks": f"{self.block_count} ({int(free.sum())} free, {len(driven)} driven: {_short_list(driven)})",
+            "free blocks": _short_list([n for n, f in zip(self.block_names, free) if f]),
+            "free mass": f"{float(m.block_mass[free].sum()):.4g} kg",
+            "free blocks span": "  ".join(f"{a} {lo[i]:.3g}..{hi[i]:.3g}" for i, a in enumerate("xyz")) + " m",
+            "interface points": f"{self.point_count}",
+            "groups": ", ".join(self.group_names),
+            "joints": f"kn {'/'.join(kn)} Pa/m, friction {'/'.join(phi)} deg",
+            "damping": f"alpha {d.alpha:g} 1/s, beta {d.beta:g} s"
+            + (f" (beta = \"{self.beta_choice.mode}\")" if self.beta_choice is not None else "")
+            + (f", local {d.local:g}" if d.local else ""),
+            "loading": ", ".join(loading) or "gravity only",
+        }
+
+    def __repr__(self) -> str:
+        rows = self.summary()
+        return "rockdem Model\n" + "\n".join(f"  {k:<17} {v}" for k, v in rows.items())
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        rows = "".join(f"<tr><th style='text-align:left'>{escape(k)}</th><td style='text-align:left'>{escape(v)}</td></tr>"
+                       for k, v in self.summary().items())
+        return f"<b>rockdem Model</b><table>{rows}</table>"
 
     def block_id(self, name: str) -> int:
         """Index of the block called ``name``."""
@@ -563,6 +649,36 @@ class ModelBuilder:
             raise ValueError("body acceleration: acceleration values must be finite")
         self.body_acceleration = (t, a)
 
+    def input_arrays(self) -> dict[str, Any]:
+        """The prescribed-kinematics fields of :class:`ModelArrays` (``block_motion``,
+        ``motion_start``, ``motion_time``, ``motion_velocity``, ``ground_motion``, ``body_time``,
+        ``body_acceleration``) of the blocks and loading set so far. :meth:`finalize` uses it, and
+        :meth:`Model.with_inputs` swaps them into a built model (another record or scale)."""
+        motions: list[Motion] = []
+        ground_index = -1
+        if self.ground_motion is not None:
+            motions.append(self.ground_motion)
+            ground_index = 0
+        block_motion = []
+        for blk in self._blocks:
+            if isinstance(blk.driven, Motion):
+                motions.append(blk.driven)
+                block_motion.append(len(motions) - 1)
+            elif blk.driven == GROUND:
+                block_motion.append(ground_index)
+            else:
+                block_motion.append(-1)
+        bt, ba = self.body_acceleration if self.body_acceleration is not None else (np.zeros(0), np.zeros((0, 3)))
+        return {
+            "block_motion": np.array(block_motion, dtype=np.int64),
+            "motion_start": np.cumsum([0] + [len(mo.time) for mo in motions]).astype(np.int64),
+            "motion_time": np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0),
+            "motion_velocity": np.concatenate([mo.velocity for mo in motions]) if motions else np.zeros((0, 3)),
+            "ground_motion": int(ground_index),
+            "body_time": bt,
+            "body_acceleration": ba,
+        }
+
     # -- freeze -------------------------------------------------------------------------------
     def finalize(
         self,
@@ -600,7 +716,7 @@ class ModelBuilder:
                         "set_material(...) for that pair or set builder.default_material"
                     )
                 mats[(ga, gb)] = mat
-        tables = {name: np.zeros((ng, ng)) for name in ("kn", "ks", "c", "ft", "tf", "rc", "rtf", "beta")}
+        tables = {name: np.zeros((ng, ng)) for name in ("kn", "ks", "c", "ft", "tf", "rc", "rtf")}
         bonded = np.zeros((ng, ng), dtype=np.bool_)
         for (ga, gb), mat in mats.items():
             a, b = gi[ga], gi[gb]
@@ -611,23 +727,9 @@ class ModelBuilder:
             tables["tf"][a, b] = mat.tan_friction
             tables["rc"][a, b] = mat.residual_cohesion
             tables["rtf"][a, b] = mat.tan_residual_friction
-            tables["beta"][a, b] = (0.0 if damping.beta_mode else damping.beta) if mat.beta is None else mat.beta
             bonded[a, b] = mat.bonded
-
-        motions: list[Motion] = []
-        ground_index = -1
-        if self.ground_motion is not None:
-            motions.append(self.ground_motion)
-            ground_index = 0
-        block_motion = []
-        for blk in self._blocks:
-            if isinstance(blk.driven, Motion):
-                motions.append(blk.driven)
-                block_motion.append(len(motions) - 1)
-            elif blk.driven == GROUND:
-                block_motion.append(ground_index)
-            else:
-                block_motion.append(-1)
+        inputs = self.input_arrays()
+        block_motion = inputs.pop("block_motion")
 
         nb = len(self._blocks)
         mass = np.zeros(nb)
@@ -679,10 +781,6 @@ class ModelBuilder:
             contact_tolerance = max(0.01 * min_dim, 1.5 * opening)
         if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
             raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
-        motion_t = np.concatenate([mo.time for mo in motions]) if motions else np.zeros(0)
-        motion_v = np.concatenate([mo.velocity for mo in motions]) if motions else np.zeros((0, 3))
-        mstart = np.cumsum([0] + [len(mo.time) for mo in motions]).astype(np.int64)
-        bt, ba = self.body_acceleration if self.body_acceleration is not None else (np.zeros(0), np.zeros((0, 3)))
         axis = np.asarray(rocking_axis, dtype=float).reshape(3)
         if not np.linalg.norm(axis) > 0:
             raise ValueError("rocking_axis must be a non-zero 3-vector")
@@ -692,7 +790,7 @@ class ModelBuilder:
             block_inertia=inertia,
             block_inv_inertia=np.where(free_mask[:, None], 1.0 / inertia, 0.0),
             block_free=free_mask,
-            block_motion=np.array(block_motion, dtype=np.int64),
+            block_motion=block_motion,
             block_group=np.array([gi[blk.group] for blk in self._blocks], dtype=np.int64),
             block_radius=radius,
             **geometry,
@@ -703,18 +801,10 @@ class ModelBuilder:
             mat_tan_friction=tables["tf"],
             mat_res_cohesion=tables["rc"],
             mat_res_tan_friction=tables["rtf"],
-            mat_beta=tables["beta"],
             mat_bonded=bonded,
             gravity=self.gravity.copy(),
-            alpha=float(damping.alpha),
-            alpha_relative=bool(damping.alpha_relative),
-            local_damping=float(damping.local),
-            motion_start=mstart,
-            motion_time=motion_t,
-            motion_velocity=motion_v,
-            ground_motion=int(ground_index),
-            body_time=bt,
-            body_acceleration=ba,
+            **damping_arrays(mats, tuple(groups), damping),
+            **inputs,
             contact_tol=float(contact_tolerance),
             touch_tol=0.1 * float(contact_tolerance),
             **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0, free_mask),
@@ -738,12 +828,7 @@ class ModelBuilder:
             return model
         from .targeting import choose_beta  # runs simulations of the model (imports simulate)
 
-        choice = choose_beta(self, model)
-        table = model.arrays.mat_beta.copy()
-        for ga, gb in mats:
-            table[gi[ga], gi[gb]] = choice.pair(ga, gb).beta
-        return replace(model, arrays=model.arrays._replace(mat_beta=table), damping=replace(damping, beta=choice.beta),
-                       beta_choice=choice)
+        return model.with_inputs(damping=damping, beta_choice=choose_beta(self, model))
 
     def _index(self, i: int | str) -> int:
         if isinstance(i, str):
@@ -754,6 +839,38 @@ class ModelBuilder:
         if not 0 <= i < len(self._blocks):
             raise IndexError(f"block id {i} out of range (0..{len(self._blocks) - 1})")
         return i
+
+
+def damping_arrays(
+    materials: Mapping[tuple[str, str], JointMaterial],
+    group_names: Sequence[str],
+    damping: Damping,
+    beta_choice: BetaChoice | None = None,
+) -> dict[str, Any]:
+    """The damping fields of :class:`ModelArrays`: ``mat_beta`` (ng, ng) [s], ``alpha`` [1/s],
+    ``alpha_relative``, ``local_damping``. ``mat_beta`` holds each pair's beta of ``beta_choice``
+    when given (an automatic beta resolved), else a material's own beta, else ``damping.beta``
+    (0 while ``damping.beta`` is ``"auto"`` or ``"critical"`` and not yet resolved)."""
+    gi = {g: k for k, g in enumerate(group_names)}
+    beta = np.zeros((len(group_names), len(group_names)))
+    for (ga, gb), mat in materials.items():
+        if beta_choice is not None:
+            beta[gi[ga], gi[gb]] = beta_choice.pair(ga, gb).beta
+        else:
+            beta[gi[ga], gi[gb]] = (0.0 if damping.beta_mode else damping.beta) if mat.beta is None else mat.beta
+    return {
+        "mat_beta": beta,
+        "alpha": float(damping.alpha),
+        "alpha_relative": bool(damping.alpha_relative),
+        "local_damping": float(damping.local),
+    }
+
+
+def _short_list(names: Sequence[str], n: int = 6) -> str:
+    """The first ``n`` names, comma-separated, with the count of the rest."""
+    names = list(names)
+    more = f", ... ({len(names) - n} more)" if len(names) > n else ""
+    return ", ".join(names[:n]) + more if names else "none"
 
 
 MAX_MOTION_SAMPLES = 10_000_000

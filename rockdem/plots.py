@@ -1,8 +1,10 @@
 """Plots of results, after the figures of Galvez et al. (2022): each function takes a result
 (an xarray Dataset from :func:`rockdem.simulation.simulate` or a NetCDF path) and returns a
-Matplotlib :class:`~matplotlib.figure.Figure` (Agg, never shown).
+Matplotlib figure (:class:`InlineFigure`: never shown by pyplot, displayed inline by Jupyter as the
+value of a cell, without importing pyplot first).
 
-- :func:`plot_history`: rocking angle and normalised top displacement u/B vs time (Figs. 6, 9B, 10B, 12B, 13);
+- :func:`plot_history`: rocking angle and normalised top displacement u/B vs time (Figs. 6, 9B, 10B, 12B, 13),
+  with the input motion's acceleration, velocity and displacement under them for earthquake runs;
 - :func:`plot_restitution`: half-cycle peaks and apparent restitution e_a per impact with the
   e_eta and 0.95 e_eta lines (Eq. 6, Figs. 6D-F, 8C-D);
 - :func:`plot_bouncing`: vertical centroid displacement with airborne phases shaded (Fig. 5A);
@@ -33,11 +35,13 @@ from .kernels.rotation import axis_angle_matrix, quats_to_matrices
 __all__ = [
     "STYLE",
     "PLOTS",
+    "InlineFigure",
     "load_result",
     "rocking_direction",
     "block_dimensions",
     "top_displacement",
     "ground_displacement",
+    "ground_acceleration",
     "world_vertices",
     "plot_history",
     "plot_restitution",
@@ -72,6 +76,19 @@ STYLE: dict[str, object] = {
 """Fixed Matplotlib settings (fonts, sizes, dpi) so that images are reproducible."""
 
 _WIDTH = 7.0  # figure width [in]
+
+
+class InlineFigure(Figure):
+    """A Matplotlib figure that a notebook displays inline as a cell's value, without a prior
+    ``import matplotlib.pyplot`` or ``%matplotlib inline`` (IPython calls :meth:`_repr_png_`)."""
+
+    def _repr_png_(self) -> bytes:
+        import io
+
+        buf = io.BytesIO()
+        with rc_context(STYLE):
+            self.savefig(buf, format="png", dpi=STYLE["savefig.dpi"], bbox_inches="tight")
+        return buf.getvalue()
 
 
 def _styled(func: Callable[..., Figure]) -> Callable[..., Figure]:
@@ -236,18 +253,38 @@ def plot_history(
     t = ds.time.values
     u, src = top_displacement(ds, monitor)
     bw = float(length) if length else block_dimensions(ds, b)[0]
-    fig = Figure(figsize=(_WIDTH, 4.6))
-    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    quake = ground_acceleration(ds)
+    fig = InlineFigure(figsize=(_WIDTH, 4.6 if quake is None else 8.2))
+    axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
+    ax1, ax2 = axes[0], axes[1]
     ax1.plot(t, ds.rocking_angle.values[:, b], color="C0")
     ax1.set_ylabel("rocking angle θ [rad]")
     ax1.set_title(f"{_label(ds, 'result')}: {_block_label(ds, b)}")
     ax2.plot(t, u / bw, color="C1")
     ax2.set_ylabel("top displacement u/B [-]")
-    ax2.set_xlabel("time [s]")
     ax2.text(0.99, 0.03, f"{src}; B = {bw:.3g} m", transform=ax2.transAxes, ha="right", va="bottom", fontsize=7)
+    if quake is not None:
+        from .spectra import plot_ground_motion_axes
+
+        plot_ground_motion_axes(tuple(axes[2:]), t, quake)
+        rec = f" {ds.attrs['earthquake_record']}" if "earthquake_record" in ds.attrs else ""
+        axes[2].set_title(f"input motion{rec}, along the rocking direction", fontsize=8)
+    axes[-1].set_xlabel("time [s]")
     fig.align_ylabels()
     fig.tight_layout()
     return fig
+
+
+def ground_acceleration(ds: xr.Dataset) -> np.ndarray | None:
+    """Input ground acceleration (T,) [m/s^2] of an earthquake result along the rocking direction
+    (the horizontal magnitude when the record acts across it), or None for other results."""
+    if "ground_acceleration" not in ds:
+        return None
+    a = np.asarray(ds.ground_acceleration.values, dtype=float)
+    along = a @ rocking_direction(ds)
+    if np.max(np.abs(along), initial=0.0) < 1e-6 * max(float(np.max(np.abs(a), initial=0.0)), 1e-300):
+        return np.linalg.norm(a[:, :2], axis=1)
+    return along
 
 
 @_styled
@@ -282,7 +319,7 @@ def plot_restitution(result: Result, *, block: int | str | None = None, min_frac
             note = f"mean e_a = {np.mean(ea):.3f} over {ea.size} impacts"
         except ValueError as exc:  # e.g. a first peak beyond eta: Eq. 6 is undefined
             note = f"e_a undefined: {exc}"
-    fig = Figure(figsize=(_WIDTH, 3.2))
+    fig = InlineFigure(figsize=(_WIDTH, 3.2))
     ax1, ax2 = fig.subplots(1, 2)
     ax1.plot(t, np.abs(theta) / eta, color="0.6", lw=0.8, label="|θ|/η")
     ax1.plot(tp, peaks / eta, "o", color="C0", ms=4, label="peaks |θ_n|/η")
@@ -318,7 +355,7 @@ def plot_bouncing(result: Result, *, block: int | str | None = None, gap: float 
     low = lowest_point_height(ds, b)
     base = ground_displacement(ds)
     bo = bouncing(t, low, z_contact=low[0] + base[:, 2], tol=gap)
-    fig = Figure(figsize=(_WIDTH, 3.4))
+    fig = InlineFigure(figsize=(_WIDTH, 3.4))
     ax = fig.subplots()
     rel = " (relative to the ground)" if ds.block_displacement.attrs.get("reference") == "ground" else ""
     ax.plot(t, uz * 1e3, color="C0", label=f"centroid u_z{rel}")
@@ -356,7 +393,7 @@ def plot_energy(result: Result) -> Figure:
     """Energy components [J] and the balance error (relative, %) vs time."""
     ds = load_result(result)
     t = ds.time.values
-    fig = Figure(figsize=(_WIDTH, 5.0))
+    fig = InlineFigure(figsize=(_WIDTH, 5.0))
     ax1, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(2.2, 1.0))
     scale = max((float(np.max(np.abs(ds[n].values))) for n, _ in _ENERGY_LINES if n in ds), default=0.0)
     for k, (name, label) in enumerate(_ENERGY_LINES):
@@ -414,7 +451,7 @@ def plot_capacity(
     """
     items = _as_list(results)
     labels = _labels(items, labels)
-    fig = Figure(figsize=(_WIDTH, 4.0))
+    fig = InlineFigure(figsize=(_WIDTH, 4.0))
     ax = fig.subplots()
     ylabel = src = ""
     for ds, lab in zip(items, labels):
@@ -436,7 +473,7 @@ def plot_contacts(result: Result) -> Figure:
     t = ds.time.values
     total = int(ds.attrs.get("point_count", 0))
     bonded0 = int(ds.contacts_bonded.values[0]) if t.size else 0
-    fig = Figure(figsize=(_WIDTH, 3.6))
+    fig = InlineFigure(figsize=(_WIDTH, 3.6))
     ax = fig.subplots()
     series = (
         ("contacts_active", "in contact", "C0", "-"),
@@ -530,7 +567,7 @@ def plot_comparison(
     labels = _labels(items, labels)
     curves = [(ds.time.values, _quantity(ds, quantity, monitor, length)) for ds in items]
     ref = None
-    fig = Figure(figsize=(_WIDTH, 3.6))
+    fig = InlineFigure(figsize=(_WIDTH, 3.6))
     ax = fig.subplots()
     if measured is not None:
         ref = read_history_csv(measured) if isinstance(measured, (str, Path)) else tuple(map(np.asarray, measured))

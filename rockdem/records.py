@@ -20,6 +20,7 @@ found by :func:`record_path`, in this order:
 from __future__ import annotations
 
 import argparse
+import functools
 import hashlib
 import os
 import re
@@ -747,6 +748,7 @@ SHIPPED_RECORDS: tuple[ShippedRecord, ...] = (
 """The records shipped in ``rockdem/data/ground-motions`` (details in that folder's SOURCES.md)."""
 
 
+@functools.lru_cache(maxsize=1)
 def records_folder() -> Path:
     """Folder of the shipped records (package data, installed with rockdem)."""
     return Path(str(resources.files("rockdem").joinpath("data", "ground-motions")))
@@ -838,6 +840,20 @@ def record_table() -> list[dict[str, object]]:
 
 
 def _records_cli(args: argparse.Namespace) -> int:
+    if args.plot:
+        if not args.name:
+            raise ValueError("--plot needs a record: rockdem records --plot NAME (a short name, a file name or a path)")
+        from .spectra import save_record_plot
+
+        gm = read_record(args.name)
+        shipped = shipped_record(args.name)
+        label = f"{shipped.name} ({shipped.event} {shipped.date[:4]}, {shipped.station})" if shipped else gm.name
+        out = Path(args.output) if args.output else Path(f"{shipped.name if shipped else Path(args.name).stem}_record.png")
+        if out.suffix.lower() not in (".png", ".pdf"):
+            raise ValueError(f"-o {out}: the suffix must be .png or .pdf")
+        print(f"rockdem records: wrote {save_record_plot(gm, out, name=label)} (acceleration, velocity, displacement, "
+              "5 % damped response spectrum)")
+        return 0
     rows = record_table()
     if args.name:
         rec = shipped_record(args.name)
@@ -874,4 +890,8 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
         description="List the shipped ground-motion records (dt, npts and PGA read from the files), or "
                     "show one record's provenance and verify its checksum.")
     p.add_argument("name", nargs="?", help="a short name or file name: show that record's provenance")
+    p.add_argument("--plot", action="store_true",
+                   help="plot NAME (a shipped record, a file in $ROCKDEM_DATA or a path): acceleration, velocity, "
+                        "displacement and its 5 %% damped response spectrum")
+    p.add_argument("-o", "--output", help="file for --plot (.png or .pdf; default NAME_record.png)")
     p.set_defaults(func=_records_cli)

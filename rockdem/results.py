@@ -1,5 +1,11 @@
 """Results as an xarray Dataset: building, saving to NetCDF, CSV export, loading.
 
+Coordinates: ``time`` [s]; ``block``: the block names, so that ``ds.sel(block="wall")`` selects a
+block by name; ``block_id`` (block): the integer ids, indexed too: ``ds.sel(block_id=1)`` or
+``ds.isel(block=1)`` (the id is the position); ``monitor`` and ``driven_block`` names. Results
+written before the names became the coordinate hold the ids in ``block`` (positional access with
+``.values[:, b]`` and ``isel`` works for both).
+
 Variables (dims; units in each variable's ``units`` attribute):
   block_position (time, block, xyz) [m]        centroid
   block_quaternion (time, block, quat)         body principal frame -> world (w, x, y, z)
@@ -44,16 +50,37 @@ from __future__ import annotations
 import os
 import uuid
 from pathlib import Path
-from typing import Mapping
+from typing import TYPE_CHECKING, Any, Mapping, NamedTuple
 
 import numpy as np
 import xarray as xr
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
-__all__ = ["build_dataset", "block_eta", "ground_blocks", "save", "load", "export_csv"]
+__all__ = [
+    "build_dataset",
+    "damping_attrs",
+    "block_eta",
+    "block_thickness",
+    "Pivot",
+    "rocking_pivots",
+    "ground_blocks",
+    "reference_rotations",
+    "rocking_angles",
+    "ground_displacement",
+    "monitor_displacements",
+    "save",
+    "load",
+    "export_csv",
+    "contact_table",
+    "write_contact_table",
+    "with_block_index",
+]
 
 _DISSIPATED = (
     "energy_damping_mass",
@@ -73,21 +100,17 @@ def build_dataset(
 ) -> xr.Dataset:
     """Assemble the recorded frames and the model's static data into a Dataset."""
     t = rec.time
-    r = quats_to_matrices(rec.quaternion)  # (T, nb, 3, 3)
-    rref = quats_to_matrices(model.quaternion_ref)
-    rel_ref = np.einsum("tbij,bkj->tbik", r, rref)  # rotation since the untilted reference
-    rotvec = rotation_vector(rel_ref)
+    rel_ref, rotvec = reference_rotations(model, rec.quaternion)
     axis = model.rocking_axis
-    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": np.arange(model.block_count)})
+    names = np.array(model.block_names, dtype=object)
+    ds = xr.Dataset(coords={"time": ("time", t, {"units": "s"}), "block": ("block", names, {"note": "block name"})})
+    ds = with_block_index(ds.assign_coords(block_id=("block", np.arange(model.block_count), {"note": "block id"})))
     xyz = ("time", "block", "xyz")
     ds["block_position"] = (xyz, rec.position, {"units": "m"})
     ds["block_quaternion"] = (("time", "block", "quat"), rec.quaternion, {"units": "1"})
     ds["block_velocity"] = (xyz, rec.velocity, {"units": "m/s"})
     ds["block_angular_velocity"] = (xyz, rec.omega, {"units": "rad/s"})
-    ground = ground_blocks(model)
-    u_ground = np.zeros((len(t), 3))
-    if ground.size:
-        u_ground = rec.position[:, ground[0]] - model.position0[ground[0]]  # they translate together
+    u_ground = ground_displacement(model, rec.position)
     moving = bool(np.any(u_ground != 0.0))
     ref = "ground" if moving else "fixed frame"
     rel_note = ("relative to the ground (the blocks added with driven='ground'); absolute in the *_absolute "
@@ -98,13 +121,9 @@ def build_dataset(
     ds["block_displacement"] = (xyz, u_abs - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
     ds["block_displacement_absolute"] = (xyz, u_abs, {"units": "m", "reference": "fixed frame", "note": abs_note})
     ds["block_rotation"] = (xyz, rotvec, {"units": "rad"})
-    ds["rocking_angle"] = (("time", "block"), rotvec @ axis, {"units": "rad", "axis": axis.tolist()})
+    ds["rocking_angle"] = (("time", "block"), rocking_angles(model, rotvec), {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)
-    mdisp = np.zeros((len(t), len(names), 3))
-    for k, name in enumerate(names):
-        b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
-        arm = p_ref - model.position_ref[b]
-        mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + rec.position[:, b] - p_ref
+    mdisp = monitor_displacements(model, rel_ref, rec.position, monitors)
     ds = ds.assign_coords(monitor=np.array(names, dtype=object) if names else np.zeros(0, dtype=object))
     mon = ("time", "monitor", "xyz")
     ds["monitor_displacement"] = (mon, mdisp - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
@@ -156,19 +175,64 @@ def build_dataset(
         {
             "rocking_axis": axis.tolist(),
             "gravity": m.gravity.tolist(),
-            "alpha": model.damping.alpha,
-            "beta": model.damping.beta,
-            "alpha_relative": int(model.damping.alpha_relative),
-            "local_damping": model.damping.local,
+            **damping_attrs(model),
             "point_count": model.point_count,
             "contact_tolerance": m.contact_tol,
             "rockdem_version": _version(),
             "displacement_reference": ref,
         }
     )
-    if model.beta_choice is not None:
-        ds.attrs.update(model.beta_choice.attrs())
     return ds
+
+
+def damping_attrs(model: Model) -> dict[str, Any]:
+    """A result's damping attributes: alpha [1/s], beta [s] (the chosen one for an automatic beta),
+    alpha_relative, local_damping, and how an automatic beta was chosen
+    (:meth:`rockdem.beta_choice.BetaChoice.attrs`). ``build_dataset`` and the batch path's
+    summary rows (:func:`rockdem.batch.frames_from_run`) both use it."""
+    d = model.damping
+    out: dict[str, Any] = {"alpha": d.alpha, "beta": d.beta, "alpha_relative": int(d.alpha_relative), "local_damping": d.local}
+    if model.beta_choice is not None:
+        out.update(model.beta_choice.attrs())
+    return out
+
+
+def reference_rotations(model: Model, quaternion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations since the untilted reference pose: matrices R(t) R_ref^T (T, nb, 3, 3) and their
+    rotation vectors (T, nb, 3) [rad], from recorded quaternions (T, nb, 4). :func:`build_dataset`
+    and the summary rows of studies both call this, so their values are bit-identical."""
+    r = quats_to_matrices(quaternion)  # (T, nb, 3, 3)
+    rref = quats_to_matrices(model.quaternion_ref)
+    rel_ref = r @ np.swapaxes(rref, -1, -2)
+    return rel_ref, rotation_vector(rel_ref)
+
+
+def rocking_angles(model: Model, rotvec: np.ndarray) -> np.ndarray:
+    """(T, nb) rotation about the model's rocking axis [rad] from rotation vectors (T, nb, 3)."""
+    return rotvec @ model.rocking_axis
+
+
+def ground_displacement(model: Model, position: np.ndarray) -> np.ndarray:
+    """(T, 3) displacement of the ground-following driven blocks [m] (zeros without any), from
+    recorded centroids (T, nb, 3): they translate together."""
+    ground = ground_blocks(model)
+    if not ground.size:
+        return np.zeros((position.shape[0], 3))
+    return position[:, ground[0]] - model.position0[ground[0]]
+
+
+def monitor_displacements(
+    model: Model, rel_ref: np.ndarray, position: np.ndarray, monitors: Mapping[str, tuple[int, np.ndarray]]
+) -> np.ndarray:
+    """(T, nm, 3) displacement of each monitor point from its reference (untilted) position, in the
+    model's fixed frame [m], from the rotations of :func:`reference_rotations` and centroids (T, nb, 3)."""
+    names = list(monitors)
+    mdisp = np.zeros((position.shape[0], len(names), 3))
+    for k, name in enumerate(names):
+        b, p_ref = monitors[name]  # point given in the reference (untilted) configuration
+        arm = p_ref - model.position_ref[b]
+        mdisp[:, k] = np.einsum("tij,j->ti", rel_ref[:, b], arm) + position[:, b] - p_ref
+    return mdisp
 
 
 def ground_blocks(model: Model) -> np.ndarray:
@@ -179,6 +243,53 @@ def ground_blocks(model: Model) -> np.ndarray:
     return np.flatnonzero((m.block_motion == m.ground_motion) & ~m.block_free.astype(bool))
 
 
+class Pivot(NamedTuple):
+    """Rigid rocking of a free block about one edge of its base (reference, untilted pose).
+
+    Attributes:
+        eta: instability angle atan(half / height) [rad].
+        radius: distance R from the centroid to the pivot edge in the rocking plane [m].
+        inertia: moment of inertia I_O about the pivot edge (the rocking axis through it) [kg m^2].
+        mass: block mass [kg].
+    """
+
+    eta: float
+    radius: float
+    inertia: float
+    mass: float
+
+    @property
+    def p(self) -> float:
+        """Housner's frequency parameter sqrt(m g R / I_O) [rad/s] at g = 9.81 m/s^2 (sqrt(3 g / 4 R)
+        for a rectangular block)."""
+        return float(np.sqrt(self.mass * 9.81 * self.radius / self.inertia))
+
+
+def _base(model: Model, b: int) -> tuple[float, float, float] | None:
+    """(height of the centroid above the base, half base toward +d, half base toward -d) [m] of
+    free block b about the rocking direction d = rocking_axis x up; None without a rocking direction."""
+    m = model.arrays
+    g = m.gravity
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    d = np.cross(model.rocking_axis, up)
+    if np.linalg.norm(d) == 0:
+        return None
+    d /= np.linalg.norm(d)
+    rref = quats_to_matrices(model.quaternion_ref[b])
+    v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref.T
+    z = v @ up
+    size = float(np.ptp(v, axis=0).max())
+    base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
+    return -float(z.min()), float(np.max(base @ d)), -float(np.min(base @ d))
+
+
+def block_thickness(model: Model) -> np.ndarray:
+    """(nb,) smallest extent of each block along its principal axes [m]."""
+    m = model.arrays
+    v, start = m.vertex_local, m.block_vertex_start
+    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
+
+
 def block_eta(model: Model) -> np.ndarray:
     """Instability (slenderness) angle of each free block about its base edges [rad], NaN for
     driven blocks, at the reference (untilted) pose: atan(horizontal distance from the centroid to
@@ -186,25 +297,36 @@ def block_eta(model: Model) -> np.ndarray:
     above the base). The base face is the block's lowest vertices, so a reduced (chamfered) base
     gives the angle about the pivot the block actually rocks on, as :meth:`ModelBuilder.tilt` uses.
     The rocking direction is rocking_axis x up (up opposes gravity)."""
-    m = model.arrays
-    g = m.gravity
-    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    d = np.cross(model.rocking_axis, up)
     out = np.full(model.block_count, np.nan)
-    if np.linalg.norm(d) == 0:
-        return out
-    d /= np.linalg.norm(d)
-    rref = quats_to_matrices(model.quaternion_ref)
-    for b in np.flatnonzero(m.block_free):
-        v = m.vertex_local[m.block_vertex_start[b] : m.block_vertex_start[b + 1]] @ rref[b].T
-        z = v @ up
-        size = float(np.ptp(v, axis=0).max())
-        base = v[z <= z.min() + 1e-9 * size]  # the base contact face (vertices relative to the centroid)
-        height = -float(z.min())
-        half = min(float(np.max(base @ d)), -float(np.min(base @ d)))
+    for b in np.flatnonzero(model.arrays.block_free):
+        base = _base(model, int(b))
+        if base is None:
+            return out
+        height, plus, minus = base
+        half = min(plus, minus)
         if height > 0 and half > 0:
             out[b] = float(np.arctan2(half, height))
     return out
+
+
+def rocking_pivots(model: Model, block: int) -> tuple[Pivot, Pivot] | None:
+    """The two base edges of free block ``block``: toward +d (a positive ``rocking_angle`` tips the
+    block over it) and toward -d, d = rocking_axis x up; None when the block has no base to rock on."""
+    base = _base(model, block)
+    if base is None:
+        return None
+    height, plus, minus = base
+    if not (height > 0 and plus > 0 and minus > 0):
+        return None
+    m = model.arrays
+    rref = quats_to_matrices(model.quaternion_ref[block])
+    i_axis = float(np.sum(m.block_inertia[block] * (rref.T @ model.rocking_axis) ** 2))
+    mass = float(m.block_mass[block])
+    out = []
+    for half in (plus, minus):
+        r = float(np.hypot(half, height))
+        out.append(Pivot(float(np.arctan2(half, height)), r, i_axis + mass * r * r, mass))
+    return out[0], out[1]
 
 
 def _version() -> str:
@@ -236,8 +358,8 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out = ds.copy()
     for name in ("block_group", "block_name"):
         out[name] = out[name].astype(str)
-    for coord in ("monitor", "driven_block"):
-        if coord in out.coords:
+    for coord in ("block", "monitor", "driven_block"):
+        if coord in out.coords and out[coord].dtype == object:
             out = out.assign_coords({coord: out[coord].astype(str)})
     out["block_free"] = out["block_free"].astype(np.int8)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
@@ -257,6 +379,14 @@ def load(path: str | Path) -> xr.Dataset:
         raise FileNotFoundError(f"no result file at {p}")
     ds = xr.load_dataset(p)
     ds["block_free"] = ds["block_free"].astype(bool)
+    return with_block_index(ds)
+
+
+def with_block_index(ds: xr.Dataset) -> xr.Dataset:
+    """Index the ``block_id`` coordinate (if any) so that ``ds.sel(block_id=1)`` selects by id, as
+    ``ds.sel(block="wall")`` does by name (an index is not stored in NetCDF: :func:`load` adds it)."""
+    if "block_id" in ds.coords and "block_id" not in ds.xindexes:
+        ds = ds.set_xindex("block_id")
     return ds
 
 
@@ -294,3 +424,113 @@ def export_csv(ds: xr.Dataset, path: str | Path) -> Path:
     p.parent.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(cols).to_csv(p, index=False)
     return p
+
+
+def contact_table(ds: xr.Dataset) -> "pd.DataFrame":
+    """The contact snapshots of a result (run with ``contact_interval``) as one long table: a row per
+    snapshot and sub-contact (interface point with a partner block).
+
+    Columns: time [s], point, block, partner (names), x, y, z [m] (world), nx, ny, nz (unit normal of
+    the partner face, into ``block``), normal_force [N] (elastic, compression > 0), shear_force [N]
+    (magnitude), fnx, fny, fnz and fsx, fsy, fsz [N] (the elastic normal and shear force vectors on
+    ``block``, world), bonded (bool), failed (0 intact, 1 tension, 2 shear), area [m^2] (tributary).
+
+    Raises:
+        ValueError: the result has no contact snapshots.
+    """
+    import pandas as pd
+
+    if "contact_time" not in ds.coords:
+        raise ValueError("the result has no contact snapshots: run it with contact_interval "
+                         "([run] contact_interval = 0.05 in the case file, or --set run.contact_interval=0.05)")
+    partner = ds.point_partner.values
+    snap, point = np.nonzero(partner >= 0)
+    names = np.asarray(ds.block_name.values, dtype=object)
+    fn = ds.point_normal_force.values[snap, point]
+    normal = ds.point_normal.values[snap, point] if "point_normal" in ds else np.full((snap.size, 3), np.nan)
+    fs = (ds.point_shear_force_vector.values[snap, point] if "point_shear_force_vector" in ds
+          else np.full((snap.size, 3), np.nan))
+    pos = ds.point_position.values[snap, point]
+    cols: dict[str, np.ndarray] = {
+        "time": ds.contact_time.values[snap],
+        "point": point,
+        "block": names[ds.point_block.values[point]],
+        "partner": names[partner[snap, point]],
+        "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
+        "nx": normal[:, 0], "ny": normal[:, 1], "nz": normal[:, 2],
+        "normal_force": fn,
+        "shear_force": ds.point_shear_force.values[snap, point],
+        "fnx": fn * normal[:, 0], "fny": fn * normal[:, 1], "fnz": fn * normal[:, 2],
+        "fsx": fs[:, 0], "fsy": fs[:, 1], "fsz": fs[:, 2],
+        "bonded": ds.point_bonded.values[snap, point] > 0,
+        "failed": ds.point_failed.values[snap, point].astype(np.int8),
+        "area": ds.point_area.values[point],
+    }
+    return pd.DataFrame(cols)
+
+
+def _has_pyarrow() -> bool:
+    import importlib.util
+
+    return importlib.util.find_spec("pyarrow") is not None
+
+
+def write_contact_table(ds: xr.Dataset, path: str | Path, fmt: str = "auto") -> Path:
+    """Write :func:`contact_table` as CSV or Parquet; returns the path written.
+
+    Args:
+        path: the file; with ``fmt="auto"`` and no .csv/.parquet suffix, the suffix is chosen:
+            .parquet when pyarrow is installed, else .csv.
+        fmt: "auto" (by suffix, as above), "csv" or "parquet" (needs pyarrow).
+    """
+    p = Path(path)
+    if fmt not in ("auto", "csv", "parquet"):
+        raise ValueError(f"contact table format must be 'auto', 'csv' or 'parquet', got {fmt!r}")
+    if fmt == "auto":
+        fmt = p.suffix.lower().lstrip(".") if p.suffix.lower() in (".csv", ".parquet") else (
+            "parquet" if _has_pyarrow() else "csv")
+    if fmt == "parquet" and not _has_pyarrow():
+        raise ValueError(f"{p}: Parquet needs pyarrow (pip install pyarrow); write a .csv instead")
+    if p.suffix.lower() != f".{fmt}":
+        p = p.with_name(p.name + f".{fmt}") if p.suffix.lower() not in (".csv", ".parquet") else p.with_suffix(f".{fmt}")
+    table = contact_table(ds)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "parquet":
+        table.to_parquet(p, index=False)
+    else:
+        table.to_csv(p, index=False)
+    return p
+
+
+@xr.register_dataset_accessor("rockdem")
+class ResultSummary:
+    """``ds.rockdem``: a short summary of a rockdem result (the run's summary table: steps,
+    timestep, peaks, energy balance, failed sub-contacts, rocking analysis), shown as text by
+    ``print(ds.rockdem)`` and as a table in a notebook; ``ds.rockdem.plot(kind)`` draws one of
+    :data:`rockdem.plots.PLOTS`."""
+
+    def __init__(self, ds: xr.Dataset) -> None:
+        self._ds = ds
+
+    def lines(self) -> list[str]:
+        """The summary rows (as printed by ``rockdem run``)."""
+        from .run_cli import summary_lines
+
+        return summary_lines(self._ds)
+
+    def __repr__(self) -> str:
+        name = self._ds.attrs.get("name", "")
+        return f"rockdem result{' ' + str(name) if name else ''}\n" + "\n".join("  " + line for line in self.lines())
+
+    def _repr_html_(self) -> str:
+        from html import escape
+
+        return "<b>rockdem result</b><pre>" + escape("\n".join(self.lines())) + "</pre>"
+
+    def plot(self, kind: str = "history", **options: object) -> object:
+        """A figure of :data:`rockdem.plots.PLOTS` (``"history"``, ``"energy"``, ...), shown inline."""
+        from .plots import PLOTS
+
+        if kind not in PLOTS:
+            raise ValueError(f"plot kind {kind!r} unknown; use one of {sorted(PLOTS)}")
+        return PLOTS[kind](self._ds, **options)

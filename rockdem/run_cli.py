@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import tempfile
 import time
@@ -12,41 +13,51 @@ from typing import Any
 import numpy as np
 import xarray as xr
 
+from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, stop_on_signals
-from .results import export_csv, save
+from .results import export_csv, save, write_contact_table
 from .simulation import simulate
+from .stopping import STOP_MODES
 
-__all__ = ["run_case", "register_cli", "summary_lines"]
+__all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
 
 
-def run_case(case: Case, *, duration: float | None = None, progress: bool | None = None) -> xr.Dataset:
+def run_case(
+    case: Case,
+    *,
+    duration: float | None = None,
+    progress: bool | None = None,
+    initial: Checkpoint | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float | None = None,
+) -> xr.Dataset:
     """Run a built case with its own options (``duration`` overrides [run] duration).
 
     The loading's attributes (``case.attrs``) go into the result's attrs, its input series
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
+    ``initial``, ``checkpoint`` and ``checkpoint_every`` are :func:`~rockdem.simulation.simulate`'s.
     """
-    r = case.run
-    dur = duration if duration is not None else r.duration
-    if r.record_interval > dur:
-        raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
-    ds = simulate(
-        case.model,
-        dur,
-        dt=r.dt,
-        timestep_rule=r.timestep_rule,
-        safety=r.safety,
-        resolution=r.resolution,
-        record_interval=r.record_interval,
-        monitors=case.monitors,
-        progress=progress,
-    )
+    ds = simulate(case.model, **run_options(case, duration), progress=progress, initial=initial, checkpoint=checkpoint,
+                  checkpoint_every=checkpoint_every)
     ds.attrs.update(case.attrs)
     t = ds.time.values
     for name, (ts, values) in case.series.items():
         v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])
         ds[name] = (("time", "xyz"), v, {"units": "m/s2" if "acceleration" in name else "1"})
     return ds
+
+
+def run_options(case: Case, duration: float | None = None) -> dict[str, Any]:
+    """The :func:`rockdem.simulation.simulate` arguments of a case (``duration`` overrides
+    [run] duration), checked: the record interval must not exceed the simulated time."""
+    r = case.run
+    dur = duration if duration is not None else r.duration
+    if r.record_interval > dur:
+        raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
+    return {"duration": dur, "dt": r.dt, "timestep_rule": r.timestep_rule, "safety": r.safety, "resolution": r.resolution,
+            "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
+            "stop": r.stop}
 
 
 def _row(label: str, value: str, unit: str = "", note: str = "") -> str:
@@ -125,6 +136,10 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             lines.extend(_analysis_lines(ds, b, skip=("max_rotation_rad",) if b == peak_block else ()))
     else:
         lines.append(_row("recorded frames", f"{n}", "", "nothing to summarise"))
+    if a.get("stop_reason"):
+        what = {"overturned": f"block {a.get('stop_block')!r} overturned", "fell": f"block {a.get('stop_block')!r} fell",
+                "rest": "at rest after the input"}.get(a["stop_reason"], a["stop_reason"])
+        lines.append(f"STOPPED at t = {a['stop_time']:.4g} s: {what} (stop = {a.get('stop_rule')!r}); the outcome was decided")
     if a.get("diverged"):
         lines.append(f"DIVERGED at t = {a['diverged_time']:.4g} s: the result holds the sound frames before it")
     if a.get("interrupted"):
@@ -162,37 +177,40 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
 
 
 def plot_rocking(ds: xr.Dataset, path: Path) -> Path:
-    """Rotation and top displacement versus time, saved as PNG."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    """Rotation and top displacement versus time (and the input motion of an earthquake run),
+    saved as PNG."""
+    from .plots import InlineFigure, STYLE, ground_acceleration, save_figure
+    from matplotlib import rc_context
 
     free = np.flatnonzero(ds.block_free.values)
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    t = ds.time.values
-    for b in free:
-        axes[0].plot(t, np.degrees(ds.rocking_angle.values[:, b]), label=str(ds.block_name.values[b]))
-    axes[0].set_ylabel("rocking angle [deg]")
-    axes[0].grid(True, alpha=0.3)
-    if len(free) <= 8:
-        axes[0].legend(loc="upper right", fontsize=8)
-    if ds.sizes.get("monitor", 0):
-        for j, name in enumerate(ds.monitor.values):
-            axes[1].plot(t, ds.monitor_displacement.values[:, j, 0] * 1e3, label=f"{name} (x)")
-        axes[1].set_ylabel("displacement [mm]")
-        axes[1].legend(loc="upper right", fontsize=8)
-    else:
+    quake = ground_acceleration(ds)
+    with rc_context(STYLE):
+        fig = InlineFigure(figsize=(8, 6 if quake is None else 9.5))
+        axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
+        t = ds.time.values
         for b in free:
-            axes[1].plot(t, ds.block_displacement.values[:, b, 0] * 1e3)
-        axes[1].set_ylabel("centroid displacement x [mm]")
-    axes[1].set_xlabel("time [s]")
-    axes[1].grid(True, alpha=0.3)
-    fig.tight_layout()
+            axes[0].plot(t, np.degrees(ds.rocking_angle.values[:, b]), label=str(ds.block_name.values[b]))
+        axes[0].set_ylabel("rocking angle [deg]")
+        if len(free) <= 8:
+            axes[0].legend(loc="upper right", fontsize=8)
+        if ds.sizes.get("monitor", 0):
+            for j, name in enumerate(ds.monitor.values):
+                axes[1].plot(t, ds.monitor_displacement.values[:, j, 0] * 1e3, label=f"{name} (x)")
+            axes[1].set_ylabel("displacement [mm]")
+            axes[1].legend(loc="upper right", fontsize=8)
+        else:
+            for b in free:
+                axes[1].plot(t, ds.block_displacement.values[:, b, 0] * 1e3)
+            axes[1].set_ylabel("centroid displacement x [mm]")
+        if quake is not None:
+            from .spectra import plot_ground_motion_axes
+
+            plot_ground_motion_axes(tuple(axes[2:]), t, quake)
+        axes[-1].set_xlabel("time [s]")
+        fig.align_ylabels()
+        fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def _output_folder(path: Path, what: str, files: tuple[str, ...]) -> Path:
@@ -218,29 +236,51 @@ def _run(args: argparse.Namespace) -> int:
         return 0
     if (args.case is None) == (args.example is None):
         raise ValueError("give a case file (rockdem run CASE.toml) or --example NAME, not both")
+    if args.from_ and args.settled:
+        raise ValueError("give --from CHECKPOINT (continue a run) or --settled CHECKPOINT (a new run from its state), not both")
     data = example_case(args.example) if args.example else load_case(args.case)
     data = apply_overrides(data, args.set or [])
+    if args.stop is not None:
+        data = apply_overrides(data, [f'run.stop="{args.stop}"'])
     t0 = time.perf_counter()
     case = parse_case(data)
+    initial = None
+    if args.from_ or args.settled:
+        initial = load_checkpoint(args.from_ or args.settled)
+        initial = initial.reset_clock() if args.settled else initial
+        initial.check_model(case.model)
     out = Path(args.out or case.output["directory"] or Path("results") / case.name)
-    files = ("result.nc", "histories.csv", "rocking.png")
+    files = ("result.nc", "histories.csv", "rocking.png", "checkpoint.npz", "contacts.csv", "contacts.parquet")
     _output_folder(out, "--out" if args.out else "[output] directory" if case.output["directory"] else "output folder", files)
+    save_ck = case.output["checkpoint"] and not args.no_checkpoint
+    every = args.checkpoint_every if args.checkpoint_every is not None else case.output["checkpoint_every"]
+    if every is not None and not save_ck:
+        raise ValueError("--checkpoint-every needs checkpoints: drop --no-checkpoint ([output] checkpoint = false)")
     received: list[int] = []
     with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
-        ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False)
+        ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False, initial=initial,
+                      checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every)
     wall = time.perf_counter() - t0
     with hold_signals(received, "saving the results computed so far"):
         written = [save(ds, out / "result.nc")]
         if case.output["csv"]:
             written.append(export_csv(ds, out / "histories.csv"))
+        if "contact_time" in ds.coords and case.output["contacts"] != "none":
+            written.append(write_contact_table(ds, out / "contacts", case.output["contacts"]))
         if case.output["plot"] and not args.no_plot:
             written.append(plot_rocking(ds, out / "rocking.png"))
+        if "checkpoint" in ds.attrs:
+            written.append(Path(ds.attrs["checkpoint"]))
     print(f"rockdem run: {case.name}")
     for line in summary_lines(ds):
         print("  " + line)
     print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
         print("  " + _row("wrote", "", "", str(p)))
+    if "checkpoint" in ds.attrs and (received or ds.attrs.get("interrupted")):
+        src = f"--example {args.example}" if args.example else str(args.case)
+        print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else "")
+              + (f" --stop {args.stop}" if args.stop else ""))
     if received or ds.attrs.get("interrupted"):  # stopped, or interrupted while saving (the save went on)
         return 128 + (received[0] if received else signal.SIGINT)
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
@@ -251,8 +291,8 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "run",
         help="run a case file or a built-in example",
-        description="Run a TOML case file (or a built-in example), save result.nc, histories.csv and "
-        "rocking.png, and print a summary.",
+        description="Run a TOML case file (or a built-in example), save result.nc, histories.csv, "
+        "rocking.png and checkpoint.npz (contacts.csv with [run] contact_interval), and print a summary.",
         epilog="Exit status: 0 done; 2 bad input (nothing run); 3 the run diverged (the result holds the "
         "frames before it); 128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP): the frames "
         "computed so far are saved. An interrupt while saving is held (the save goes on); a second one "
@@ -264,6 +304,19 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", help="output directory (default results/<case name>)")
     p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE", help="override a case value")
     p.add_argument("--duration", type=positive_float, help="simulated time [s], overrides [run] duration")
+    p.add_argument("--stop", choices=STOP_MODES, default=None,
+                   help="end the run once its outcome is decided: collapsed, or at rest after the input "
+                   "(default: [run] stop, off; docs/studies.md)")
     p.add_argument("--no-plot", action="store_true", help="do not write the PNG plot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--from", dest="from_", metavar="CHECKPOINT",
+                   help="continue the run saved in CHECKPOINT (OUT/checkpoint.npz) up to the case's duration "
+                        "(or --duration): the same case and options; the result holds all frames from t = 0")
+    p.add_argument("--settled", metavar="CHECKPOINT",
+                   help="start this case at t = 0 from the state saved in CHECKPOINT (e.g. a model settled under "
+                        "gravity): the same blocks and joints, any loading and damping")
+    p.add_argument("--checkpoint-every", type=positive_float, metavar="SECONDS",
+                   help="also write OUT/checkpoint.npz every SECONDS of wall time (always written at the end and "
+                        "when stopped)")
+    p.add_argument("--no-checkpoint", action="store_true", help="do not write OUT/checkpoint.npz")
     p.set_defaults(func=_run)

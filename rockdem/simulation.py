@@ -7,28 +7,50 @@ breaks or its state is no longer finite (diverged), or when a free block leaves 
 (it fell through its support or flew away); the result keeps the frames before it and says where
 (``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
 ``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
-``interrupted``.
+``interrupted``. A run can be saved to a checkpoint and continued exactly (:mod:`rockdem.checkpoint`).
+With ``stop=`` (:mod:`rockdem.stopping`) the loop checks between chunks of a fixed number of steps
+whether the outcome is decided (collapsed, or at rest after the input) and ends there
+(``attrs["stop_reason"]``, ``stop_time``). :func:`run_model` is the loop without the Dataset
+(studies summarise its raw frames).
+
+A run stopped by its stop rule and checkpointed: the result ends at the decided frame, but the
+checkpoint holds the state where the loop ended (the end of the chunk in which the decision was
+made, at most ``check_steps`` steps later) and every frame computed up to there. Continued with the
+same rule, it is decided again from the saved frames and the result is the stopped run's, steps
+included, without stepping further (but for the rest of a chunk cut short, below); continued with ``stop="off"`` (or another rule), it runs on
+past the decision. A checkpoint written where the end of a run cut a chunk short keeps the time the
+chunk was to end at (``Checkpoint.check_target``): the continuation ends its first chunk there, so
+its stop checks fall where an uninterrupted run's do and a continued run with ``stop=`` is bit for
+bit an uninterrupted one with the same rule (the steps past the decision included).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import signal
+import threading
 import time as _time
 import warnings
-from typing import Any, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
 import numpy as np
 import xarray as xr
 
-from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, new_records
+from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
+from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
-from .results import build_dataset
+from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
 from .state import grow_buffers, initial_state
+from .stopping import Decision, Stopper, StopRule, stop_rule
 from .timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, TimestepInfo, stable_timestep
 
-__all__ = ["simulate", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
+__all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
 
 Monitor = tuple[int | str, Sequence[float]]
 """A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
@@ -44,26 +66,33 @@ def simulate(
     duration: float,
     *,
     dt: float | None = None,
-    timestep_rule: str = "bound",
-    safety: float = DEFAULT_SAFETY,
-    resolution: float = DEFAULT_RESOLUTION,
-    record_interval: float = 0.002,
+    timestep_rule: str | None = None,
+    safety: float | None = None,
+    resolution: float | None = None,
+    record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
     contact_interval: float | None = None,
     max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
+    initial: Checkpoint | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float | None = None,
 ) -> xr.Dataset:
-    """Run ``model`` for ``duration`` seconds and return the recorded histories.
+    """Run ``model`` until time ``duration`` and return the recorded histories.
 
     Args:
         model: a finalized model (:meth:`rockdem.model.ModelBuilder.finalize`).
-        duration: simulated time [s].
+        duration: simulated time at the end of the run [s] (continuing a checkpoint: the end time,
+            not the time added).
         dt: timestep [s]; default automatic (see :mod:`rockdem.timestep`); refused above the bound.
         timestep_rule: "bound" (default) or "3dec" (0.2 sqrt(m_min/k_max)).
-        safety: fraction of the stable bound for the automatic timestep.
-        resolution: largest omega_max dt / 2, so that impacts last several steps and keep their
-            energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
-        record_interval: time between recorded frames [s] (rounded to whole steps).
+        safety: fraction of the stable bound for the automatic timestep (default 0.9).
+        resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
+            keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
+        record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
+            the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
+            within half a step of it.
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
             configuration (before any initial tilt); displacements are measured from there.
@@ -72,67 +101,173 @@ def simulate(
             default None: none recorded.
         max_steps: a run estimated to need more steps (duration / initial dt) is refused before it
             starts, with the estimate: an absurd stiffness, mass or damping would otherwise hang.
+        stop: end the run once its outcome is decided (:mod:`rockdem.stopping`): "off" (default),
+            "decided" (collapsed, or at rest after the input), "collapse" or "rest"; the result
+            then ends at that frame and says why and when (attrs ``stop_reason``, ``stop_time``,
+            ``stop_block``). A continued run may use another rule than the checkpoint's run (see
+            the module notes for a checkpoint of a stopped run).
+        initial: a :class:`~rockdem.checkpoint.Checkpoint` (or its file) to continue: the result
+            holds the checkpoint's frames followed by the new ones, bit for bit those of an
+            uninterrupted run. The timestep and the record and contact intervals are the
+            checkpoint's (giving other values is an error). A checkpoint whose clock was reset
+            (:meth:`~rockdem.checkpoint.Checkpoint.reset_clock`) instead starts a new run at t = 0
+            from its state, on a model with the same blocks and any loading.
+        checkpoint: file written at the end of the run, when it is interrupted (Ctrl-C, or SIGTERM
+            under ``rockdem run``), and every ``checkpoint_every`` seconds of wall time; none is
+            written for a run that diverged.
+        checkpoint_every: wall time between checkpoints during the run [s]; default only at the end.
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
 
     Raises:
         TypeError: ``model`` is not a finalized Model.
-        ValueError: bad options, a timestep longer than the run, or more steps than ``max_steps``.
+        ValueError: bad options, a timestep longer than the run, more steps than ``max_steps``, or
+            a checkpoint of another model.
     """
+    out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
+                    record_interval=record_interval, monitors=monitors, progress=progress,
+                    contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
+                    checkpoint=checkpoint, checkpoint_every=checkpoint_every)
+    ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
+    return out.snapshots.attach(ds)
+
+
+class Start(NamedTuple):
+    """What a run starts from: the timestep (:func:`rockdem.timestep.stable_timestep`) and the
+    initial state and scratch arrays (:func:`rockdem.state.initial_state`). They depend on the
+    model's geometry, materials, damping and initial pose, not on its prescribed inputs (ground
+    motion, body acceleration), so the runs of a study that only change the record reuse them."""
+
+    timestep: TimestepInfo
+    state: State
+    scratch: Scratch
+
+    def copy(self) -> Start:
+        """An independent copy (every array of the state and scratch tuples copied, field by field)."""
+        def dup(nt: Any) -> Any:
+            return type(nt)(*(a.copy() if isinstance(a, np.ndarray) else a for a in nt))
+
+        return Start(self.timestep, dup(self.state), dup(self.scratch))
+
+
+def prepare_start(model: Model, *, timestep_rule: str = "bound", safety: float = DEFAULT_SAFETY,
+                  resolution: float = DEFAULT_RESOLUTION, dt: float | None = None) -> Start:
+    """The :class:`Start` of a run of ``model`` with these timestep options."""
+    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    return Start(info, *initial_state(model))
+
+
+class RunOutput(NamedTuple):
+    """What :func:`run_model` returns: the recorded frames (Records trimmed to the result's
+    frames), the result's attributes, the checked monitors (name -> (block id, reference point
+    [m])) and the contact snapshots."""
+
+    records: Records
+    attrs: dict[str, Any]
+    monitors: dict[str, tuple[int, np.ndarray]]
+    snapshots: ContactSnapshots
+
+
+def run_model(
+    model: Model,
+    duration: float,
+    *,
+    dt: float | None = None,
+    timestep_rule: str | None = None,
+    safety: float | None = None,
+    resolution: float | None = None,
+    record_interval: float | None = None,
+    monitors: Mapping[str, Monitor] | None = None,
+    progress: bool | None = None,
+    contact_interval: float | None = None,
+    max_steps: int = DEFAULT_MAX_STEPS,
+    stop: str | StopRule | None = "off",
+    start: Start | None = None,
+    initial: Checkpoint | str | os.PathLike[str] | None = None,
+    checkpoint: str | os.PathLike[str] | None = None,
+    checkpoint_every: float | None = None,
+) -> RunOutput:
+    """:func:`simulate` without building the Dataset: the raw recorded frames and attributes
+    (studies summarise these directly; same arguments). ``attrs["kernel_s"]`` is the time spent
+    inside the compiled kernel in this call [s], ``runtime_s`` the whole loop's (with the
+    checkpoint's, continuing one). ``start``: the timestep and initial state of
+    :func:`prepare_start` for this model and these options (a copy, see :meth:`Start.copy`; the
+    run mutates it), computed here when None; not with ``initial``."""
     if not isinstance(model, Model):
         hint = " (call builder.finalize() first)" if type(model).__name__ == "ModelBuilder" else ""
         raise TypeError(f"simulate: model must be a rockdem Model{hint}, got {type(model).__name__}")
     duration = _positive_number("duration", duration, "s")
-    record_interval = _positive_number("record_interval", record_interval, "s")
     if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps < 1:
         raise ValueError(f"max_steps must be a positive integer, got {max_steps!r}")
+    if checkpoint_every is not None:
+        checkpoint_every = _positive_number("checkpoint_every", checkpoint_every, "s of wall time")
+        if checkpoint is None:
+            raise ValueError("checkpoint_every needs a checkpoint file: give checkpoint=PATH")
     mon = _check_monitors(model, monitors or {})
-    snaps = ContactSnapshots(model, contact_interval)
-    info: TimestepInfo = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
-    _check_step_count(info, duration, max_steps)
-    frames = int(math.floor(duration / record_interval + 1e-9)) + 1
-    need = frames * model.block_count * 13 * 8
-    if need > _MAX_RECORD_BYTES:
-        raise ValueError(
-            f"recording {frames} frames of {model.block_count} blocks needs {need / 1e9:.1f} GB; "
-            f"raise record_interval (now {record_interval} s)"
-        )
+    rule = stop_rule(stop)
+    if start is not None and initial is not None:
+        raise ValueError("give start (a prepared fresh start) or initial (a checkpoint), not both")
+    ck = None if initial is None else load_checkpoint(initial)
     wall0 = _time.perf_counter()
-    state, scratch = initial_state(model)
-    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
-    state.safety[0] = safety
-    state.resolution[0] = resolution if info.rule == "bound" else 1.0
+    if ck is None or ck.fresh:
+        run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+                         contact_interval, max_steps, start)
+    else:
+        run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+                             contact_interval, max_steps)
+    saver = _Saver(model, run, checkpoint, checkpoint_every)
+    info, state, scratch, rec, snaps = run.info, run.state, run.scratch, run.records, run.snaps
+    frame, frames = run.frame, rec.time.shape[0]
     m = model.arrays
-    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
-    snaps.take(state)
-    rec = new_records(frames, model.block_count, int(np.count_nonzero(~m.block_free.astype(bool))))
-    frame = 0
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
-    thickness = _block_thickness(model)
+    thickness = block_thickness(model)
     chunk = 2000 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
+    stopper = Stopper(model, rule, run.record_interval) if rule is not None else None
+    decision: Decision | None = None
+    # With a stop rule, chunks of check_steps steps: ``target`` is the time the current chunk ends at
+    # (a contact snapshot or the end of the run may cut it short); see the module notes.
+    target = run.check_target if stopper is not None else None
+    if stopper is not None and frame > 0 and target is None:
+        decision = stopper.check(rec, frame)  # a continued run: the saved frames may decide it already
+    kernel = 0.0
     bar = None
     interrupted = False
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
-        while state.time[0] < t_end and frame < frames:
-            stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
-            t0 = _time.perf_counter()
-            frame, status = advance(m, state, scratch, stop, record_interval, rec, frame)
-            elapsed = _time.perf_counter() - t0
-            if status == STATUS_GROW:
-                state, scratch = grow_buffers(state, scratch)
-                continue
-            if status != STATUS_DONE:
-                break
-            sunk = _sunk(model, state, thickness)
-            if sunk is not None:
-                break
-            snaps.take(state)
-            chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+        while decision is None and state.time[0] < t_end and frame < frames:
+            # A stop signal during a chunk is raised once the chunk's bookkeeping is done, so that the
+            # state, the frame counter and the snapshots saved in a checkpoint belong together.
+            with _deferred_signals():
+                if stopper is not None:
+                    if target is None:
+                        target = float(state.time[0]) + stopper.rule.check_steps * float(state.dt[0])
+                    t_stop = snaps.clip(min(t_end, target))
+                else:
+                    t_stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
+                t0 = _time.perf_counter()
+                frame, status = advance(m, state, scratch, t_stop, run.record_interval, rec, frame)
+                elapsed = _time.perf_counter() - t0
+                kernel += elapsed
+                if status == STATUS_GROW:
+                    state, scratch = grow_buffers(state, scratch)
+                    continue
+                if status != STATUS_DONE:
+                    break
+                sunk = _sunk(model, state, thickness)
+                if sunk is not None:
+                    break
+                snaps.take(state)
+                if stopper is not None:
+                    # a new chunk starts here, unless the end of this run cut it short (kept for a continuation)
+                    target = target if t_stop == t_end < target else None
+                    decision = stopper.check(rec, frame)
+            if stopper is None:
+                chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+            saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0, target)
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
-                bar = _progress_bar(duration)
+                bar = _progress_bar(duration, run.start_time)
             if bar is not None:
                 bar.update(min(float(state.time[0]), duration) - bar.n)
     except KeyboardInterrupt:
@@ -140,7 +275,9 @@ def simulate(
     finally:
         if bar is not None:
             bar.close()
-    runtime = _time.perf_counter() - wall0
+    if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
+        decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
+    runtime = _time.perf_counter() - wall0 + run.runtime_before
     attrs: dict[str, Any] = {
         "dt": info.dt,
         "dt_min": float(state.dt_min[0]),
@@ -151,10 +288,16 @@ def simulate(
         "timestep_rule": info.rule,
         "steps": int(state.step[0]),
         "runtime_s": runtime,
+        "kernel_s": kernel,
         "duration": duration,
-        "record_interval": record_interval,
+        "record_interval": run.record_interval,
         "interrupted": int(interrupted),
+        "stop_rule": rule.mode if rule is not None else "off",
     }
+    if run.continued_from is not None:
+        attrs["continued_from_time"] = run.continued_from
+    if decision is not None:
+        attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
     if status in (STATUS_DIVERGED, STATUS_LOST):
         attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
         warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
@@ -166,6 +309,10 @@ def simulate(
         attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                       "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
         warnings.warn(msg, RuntimeWarning, stacklevel=2)
+    elif checkpoint is not None:  # every frame computed, also past a stop decision (see the module notes)
+        attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime, target))
+    if attrs.get("diverged") and checkpoint is not None:
+        attrs["checkpoint_note"] = "no checkpoint written: the run diverged"
     fell = np.flatnonzero(state.fell_off >= 0.0)
     if fell.size:
         listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
@@ -176,21 +323,162 @@ def simulate(
             "a larger foundation (the specimen builders' foundation_extent) keeps them",
             RuntimeWarning, stacklevel=2,
         )
-    rec = Records(*(a[:frame] for a in rec))
-    ds = build_dataset(model, rec, monitors=mon, attrs=attrs)
-    return snaps.attach(ds)
+    end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
+    return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
+
+
+@dataclass
+class _Run:
+    """What the time loop starts from: a fresh state, or a checkpoint's."""
+
+    info: TimestepInfo
+    state: State
+    scratch: Scratch
+    records: Records  # preallocated for every frame of the run, the first ``frame`` filled
+    frame: int
+    record_interval: float
+    snaps: ContactSnapshots
+    start_time: float = 0.0
+    runtime_before: float = 0.0
+    continued_from: float | None = None
+    check_target: float | None = None  # the end of a stop-rule chunk the run that saved it did not reach
+
+
+def _frames(model: Model, duration: float, record_interval: float) -> Records:
+    """Zeroed records for every frame of a run to ``duration`` [s], refused above 2 GB."""
+    frames = int(math.floor(duration / record_interval + 1e-9)) + 1
+    need = frames * model.block_count * 13 * 8
+    if need > _MAX_RECORD_BYTES:
+        raise ValueError(
+            f"recording {frames} frames of {model.block_count} blocks needs {need / 1e9:.1f} GB; "
+            f"raise record_interval (now {record_interval} s)"
+        )
+    driven = int(np.count_nonzero(~model.arrays.block_free.astype(bool)))
+    return new_records(frames, model.block_count, driven)
+
+
+def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float | None, rule: str | None,
+               safety: float | None, resolution: float | None, record_interval: float | None,
+               contact_interval: float | None, max_steps: int, start: Start | None = None) -> _Run:
+    """A run from t = 0: the model's initial state (``start``'s when given: its timestep and
+    arrays, used in place), or a checkpoint's state with its clock reset."""
+    interval = _positive_number("record_interval", 0.002 if record_interval is None else record_interval, "s")
+    safety = DEFAULT_SAFETY if safety is None else safety
+    resolution = DEFAULT_RESOLUTION if resolution is None else resolution
+    snaps = ContactSnapshots(model, contact_interval)
+    if start is not None:
+        info = start.timestep
+    else:
+        info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt)
+    _check_step_count(info, duration, max_steps)
+    rec = _frames(model, duration, interval)
+    if start is not None:
+        state, scratch = start.state, start.scratch
+    elif ck is None:
+        state, scratch = initial_state(model)
+    else:
+        ck.check_model(model)
+        state, scratch = ck.engine_arrays(model)
+        scratch.lost_block[:] = -1
+    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
+    state.safety[0] = safety
+    state.resolution[0] = resolution if info.rule == "bound" else 1.0
+    m = model.arrays
+    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
+    snaps.take(state)
+    return _Run(info, state, scratch, rec, 0, interval, snaps)
+
+
+def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | None, rule: str | None,
+                   safety: float | None, resolution: float | None, record_interval: float | None,
+                   contact_interval: float | None, max_steps: int) -> _Run:
+    """The run saved in ``ck``, continued to ``duration``: its state, frames and snapshots."""
+    ck.check_model(model)
+    given = {"dt": (dt, ck.timestep.dt if ck.timestep.rule == "user" else None),
+             "timestep_rule": (rule, ck.timestep.rule if ck.timestep.rule != "user" else None),
+             "safety": (safety, float(ck.state.safety[0])),
+             "resolution": (resolution, float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
+             "record_interval": (record_interval, ck.record_interval),
+             "contact_interval": (contact_interval, ck.contact_interval)}
+    for name, (value, saved) in given.items():
+        if value is not None and value != saved:
+            raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
+                             f"the options it was started with; leave {name} unset")
+    if not duration > ck.time:
+        raise ValueError(f"the checkpoint is already at t = {ck.time:.6g} s: give a duration (the end time) beyond it")
+    _check_step_count(ck.timestep, duration - ck.time, max_steps)
+    state, scratch = ck.engine_arrays(model)
+    rec = _frames(model, duration, ck.record_interval)
+    if ck.frame > rec.time.shape[0]:
+        raise ValueError(f"the checkpoint holds {ck.frame} frames, more than a run to {duration:g} s records")
+    for dst, src in zip(rec, ck.records):
+        dst[: ck.frame] = src[: ck.frame]
+    snaps = ContactSnapshots(model, ck.contact_interval)
+    snaps.restore(ck.snapshots, ck.snapshot_count)
+    return _Run(ck.timestep, state, scratch, rec, ck.frame, ck.record_interval, snaps, ck.time, ck.runtime_s, ck.time,
+                ck.check_target)
+
+
+class _Saver:
+    """Writes the run's checkpoint file (at the end, on interruption, every ``every`` s of wall time)."""
+
+    def __init__(self, model: Model, run: _Run, path: str | os.PathLike[str] | None, every: float | None) -> None:
+        self.model, self.run, self.path, self.every = model, run, path, every
+        self.last = _time.perf_counter()
+        self.hashes = (model_hash(model), structure_hash(model)) if path is not None else ("", "")
+
+    def save(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
+             runtime: float, check_target: float | None) -> Path:
+        """Write the checkpoint now (state after the last completed chunk, frames ``[:frame]``, the
+        unreached end of a stop-rule chunk)."""
+        assert self.path is not None
+        ck = Checkpoint(
+            state=state, scratch=scratch, records=Records(*(a[:frame] for a in rec)), frame=frame,
+            record_interval=self.run.record_interval, contact_interval=snaps.interval, snapshot_count=snaps.count,
+            snapshots=snaps.columns() if snaps.interval else {}, timestep=self.run.info,
+            model_hash=self.hashes[0], structure_hash=self.hashes[1], runtime_s=runtime,
+            block_names=self.model.block_names, check_target=check_target,
+        )
+        with _deferred_signals():
+            p = ck.save(self.path)
+        self.last = _time.perf_counter()
+        return p
+
+    def maybe(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
+              wall: float, check_target: float | None) -> None:
+        """Save if ``every`` seconds of wall time passed since the last save."""
+        if self.every is not None and _time.perf_counter() - self.last >= self.every:
+            self.save(state, scratch, rec, frame, snaps, wall + self.run.runtime_before, check_target)
+
+
+@contextlib.contextmanager
+def _deferred_signals() -> Iterator[None]:
+    """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
+    deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
+    halfway through it. Outside the main thread (where no signal arrives) this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[tuple[int, Any]] = []
+    old: dict[int, Any] = {}
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        handler = signal.getsignal(sig) if sig is not None else None
+        if callable(handler):
+            old[sig] = handler
+            signal.signal(sig, lambda signum, frame: held.append((signum, frame)))
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+        for signum, frame in held[:1]:
+            old[signum](signum, frame)
 
 
 SINK_FRACTION = 0.25
 """A run stops when a sub-contact's overlap exceeds this fraction of the thinner of its two blocks:
 the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
-
-
-def _block_thickness(model: Model) -> np.ndarray:
-    """(nb,) smallest extent of each block along its principal axes [m]."""
-    m = model.arrays
-    v, start = m.vertex_local, m.block_vertex_start
-    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
 
 
 def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | None:
@@ -274,11 +562,12 @@ def _failure(model: Model, rec: Records, bad: int, status: int, block: int, step
     }
 
 
-def _progress_bar(duration: float) -> Any:
+def _progress_bar(duration: float, start: float = 0.0) -> Any:
     from tqdm.auto import tqdm
 
     return tqdm(
         total=duration,
+        initial=start,
         unit="s",
         desc="rockdem",
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3f}/{total:.3f} s simulated [{elapsed}<{remaining}]",

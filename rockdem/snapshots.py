@@ -10,12 +10,20 @@ result over the dims (``contact_time``, ``point``):
   point_normal_force (contact_time, point) [N]  elastic normal force, summed over the point's partners
                                                 (compression > 0), NaN where no partner
   point_shear_force (contact_time, point) [N]   magnitude of the elastic shear force, NaN where no partner
+  point_normal (contact_time, point, xyz)       unit normal of the partner's face (of the more loaded slot),
+                                                world, pointing into the point's block; NaN where no partner.
+                                                The elastic normal force on the point's block is
+                                                point_normal_force * point_normal
+  point_shear_force_vector (contact_time, point, xyz) [N]  elastic shear force on the point's block,
+                                                world (ks A u_s summed over its partners); NaN where none
   point_bonded (contact_time, point) int8       1 bonded, 0 not, -1 where no partner
   point_failed (contact_time, point) int8       0 intact, 1 failed in tension, 2 failed in shear
                                                 (persistent: kept after the point loses its partner)
   static: point_block (point), point_area (point) [m^2], point_local (point, xyz) [m] (body frame)
 
-Size: 24 + 4 + 8 + 8 + 1 + 1 = 46 bytes per point per snapshot (before NetCDF compression).
+Size: 24 + 4 + 8 + 8 + 24 + 24 + 1 + 1 = 94 bytes per point per snapshot (before NetCDF compression).
+Forces are the elastic joint forces (springs), as 3DEC reports them; the SP dashpot forces are not
+included. Edge-to-edge point contacts (non-conformal contacts between edges) are not in the snapshots.
 """
 
 from __future__ import annotations
@@ -31,8 +39,21 @@ from .model import Model
 
 __all__ = ["ContactSnapshots", "BYTES_PER_POINT"]
 
-BYTES_PER_POINT = 46
+BYTES_PER_POINT = 94
 """Bytes stored per interface point per contact snapshot (uncompressed)."""
+
+
+_VARIABLES: dict[str, tuple[tuple[str, ...], str, dict[str, str]]] = {
+    # column -> (extra dims, dtype, attrs) of its ``point_*`` variable
+    "position": (("xyz",), "f8", {"units": "m"}),
+    "partner": ((), "i4", {"units": "1", "note": "-1: no partner"}),
+    "normal_force": ((), "f8", {"units": "N", "note": "elastic, compression > 0"}),
+    "shear_force": ((), "f8", {"units": "N", "note": "magnitude of the elastic shear force"}),
+    "normal": (("xyz",), "f8", {"units": "1", "note": "partner face normal, world, into the point's block"}),
+    "shear_force_vector": (("xyz",), "f8", {"units": "N", "note": "elastic shear force on the point's block, world"}),
+    "bonded": ((), "i1", {"units": "1", "note": "1 bonded, 0 not, -1 no partner"}),
+    "failed": ((), "i1", {"units": "1", "note": "0 intact, 1 failed in tension, 2 failed in shear"}),
+}
 
 
 class ContactSnapshots:
@@ -49,7 +70,7 @@ class ContactSnapshots:
         self.model = model
         self.interval = interval
         self.count = 0  # snapshots taken; the next is due at count * interval
-        self.rows: list[tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.rows: list[dict[str, np.ndarray | float]] = []
 
     def clip(self, stop: float) -> float:
         """Chunk stop time [s] cut so that it does not pass the next snapshot time."""
@@ -66,8 +87,8 @@ class ContactSnapshots:
         if t < due - 1e-12 * max(1.0, due):
             return
         m = self.model.arrays
-        rot = quats_to_matrices(state.quaternion)[m.point_block]  # (np, 3, 3)
-        pos = np.einsum("pij,pj->pi", rot, m.point_local) + state.position[m.point_block]
+        rots = quats_to_matrices(state.quaternion)  # (nb, 3, 3)
+        pos = np.einsum("pij,pj->pi", rots[m.point_block], m.point_local) + state.position[m.point_block]
         # A point may press on two partners (slots); report the slot carrying the larger force.
         slots = state.slot_partner
         k = np.argmax(np.where(slots >= 0, np.abs(state.slot_normal_force) + 1e-300, -1.0), axis=1)
@@ -76,34 +97,53 @@ class ContactSnapshots:
         has = partner >= 0
         normal = np.where(has, state.slot_normal_force.sum(axis=1), np.nan)
         ks = m.mat_ks[m.block_group[m.point_block][:, None], m.block_group[np.maximum(slots, 0)]]
-        shear_force = (ks * state.slot_area)[..., None] * state.slot_shear  # (np, slots, 3) [N]
-        shear = np.where(has, np.linalg.norm(shear_force.sum(axis=1), axis=1), np.nan)
-        bonded = np.where(has, state.slot_bonded.any(axis=1).astype(np.int8), np.int8(-1)).astype(np.int8)
-        failed = state.point_failed.astype(np.int8)
-        self.rows.append((t, pos, partner, normal, shear, bonded, failed))
+        shear_force = ((ks * state.slot_area)[..., None] * state.slot_shear).sum(axis=1)  # (np, 3) [N]
+        face = np.maximum(state.slot_face[rows, k], 0)
+        n_world = np.einsum("pij,pj->pi", rots[m.face_block[face]], m.face_normal[face])
+        self.rows.append({
+            "time": t,
+            "position": pos,
+            "partner": partner,
+            "normal_force": normal,
+            "shear_force": np.where(has, np.linalg.norm(shear_force, axis=1), np.nan),
+            "normal": np.where(has[:, None], n_world, np.nan),
+            "shear_force_vector": np.where(has[:, None], shear_force, np.nan),
+            "bonded": np.where(has, state.slot_bonded.any(axis=1).astype(np.int8), np.int8(-1)).astype(np.int8),
+            "failed": state.point_failed.astype(np.int8),
+        })
         # Skip snapshot times already passed (a chunk may overshoot by one step).
         self.count = int(math.floor(t / self.interval + 1e-9)) + 1
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The snapshots taken, stacked: ``time`` (S,) [s] and one (S, points, ...) array per variable."""
+        n_pts = self.model.point_count
+        out: dict[str, np.ndarray] = {"time": np.array([r["time"] for r in self.rows], dtype=float)}
+        for name, (dims, dtype, _) in _VARIABLES.items():
+            shape = (len(self.rows), n_pts) + (3,) * len(dims)
+            out[name] = np.array([r[name] for r in self.rows], dtype=dtype).reshape(shape)
+        return out
+
+    def restore(self, columns: dict[str, np.ndarray], count: int) -> None:
+        """Continue from snapshots saved by :meth:`columns` (a checkpoint) with ``count`` taken."""
+        if not self.interval:
+            return
+        missing = {"time", *_VARIABLES} - set(columns)
+        if missing and columns:
+            raise ValueError(f"the checkpoint's contact snapshots lack {sorted(missing)}")
+        n = len(columns.get("time", ()))
+        self.rows = [{k: (float(v[i]) if k == "time" else v[i]) for k, v in columns.items()} for i in range(n)]
+        self.count = int(count)
 
     def attach(self, ds: xr.Dataset) -> xr.Dataset:
         """Add the snapshots and ``point_block``, ``point_area`` to a result (unchanged if off)."""
         if self.interval is None:
             return ds
         m = self.model.arrays
-        n = len(self.rows)
-        cols = list(zip(*self.rows)) if n else [np.zeros(0)] + [np.zeros((0, m.point_area.shape[0]))] * 6
-        t, pos, partner, normal, shear, bonded, failed = (np.asarray(c) for c in cols)
-        if not n:
-            pos = np.zeros((0, m.point_area.shape[0], 3))
+        cols = self.columns()
         tp = ("contact_time", "point")
-        ds = ds.assign_coords(contact_time=("contact_time", t.astype(float), {"units": "s"}))
-        ds["point_position"] = (tp + ("xyz",), pos, {"units": "m"})
-        ds["point_partner"] = (tp, partner.astype(np.int32), {"units": "1", "note": "-1: no partner"})
-        ds["point_normal_force"] = (tp, normal.astype(float), {"units": "N", "note": "compression > 0"})
-        ds["point_shear_force"] = (tp, shear.astype(float), {"units": "N"})
-        ds["point_bonded"] = (tp, bonded.astype(np.int8), {"units": "1", "note": "1 bonded, 0 not, -1 no partner"})
-        ds["point_failed"] = (
-            tp, failed.astype(np.int8), {"units": "1", "note": "0 intact, 1 failed in tension, 2 failed in shear"}
-        )
+        ds = ds.assign_coords(contact_time=("contact_time", cols["time"], {"units": "s"}))
+        for name, (dims, _, attrs) in _VARIABLES.items():
+            ds[f"point_{name}"] = (tp + dims, cols[name], dict(attrs))
         ds["point_block"] = ("point", m.point_block.astype(np.int32))
         ds["point_local"] = (("point", "xyz"), m.point_local, {"units": "m", "note": "body frame of point_block"})
         ds["point_area"] = ("point", m.point_area, {"units": "m^2"})

@@ -21,6 +21,7 @@ def _pair_arrays(count: int) -> dict[str, np.ndarray]:
         "pair_owner_face": np.zeros(count, dtype=i64),
         "pair_target_face": np.zeros(count, dtype=i64),
         "pair_track_start": np.zeros(count, dtype=i64),
+        "pair_track_split": np.zeros(count, dtype=i64),
         "pair_track_stop": np.zeros(count, dtype=i64),
         "pair_edge_a": np.zeros(count, dtype=i64),
         "pair_edge_b": np.zeros(count, dtype=i64),
@@ -37,6 +38,12 @@ def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
         "pair_force": np.zeros((count, 3)),
         "pair_point": np.zeros((count, 3)),
         "pair_dashpot_force": np.zeros((count, 3)),
+        "pair_weight": np.zeros(count),
+        "pair_bonded": np.zeros(count, dtype=np.bool_),
+        "blend_force_owner": np.zeros((count, 3)),
+        "blend_point_owner": np.zeros((count, 3)),
+        "blend_force_target": np.zeros((count, 3)),
+        "blend_point_target": np.zeros((count, 3)),
         "prev_pair_a": np.zeros(count, dtype=i64),
         "prev_pair_b": np.zeros(count, dtype=i64),
         "prev_pair_kind": np.zeros(count, dtype=i64),
@@ -119,7 +126,10 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         contact_force=np.zeros((SLOTS * n_pts, 3)),
         contact_point=np.zeros((SLOTS * n_pts, 3)),
         dashpot_force=np.zeros((SLOTS * n_pts, 3)),
-        track_cover=np.zeros((SLOTS * n_pts, 3)),
+        track_area=np.zeros(SLOTS * n_pts),
+        track_point_u=np.zeros(SLOTS * n_pts),
+        track_point_w=np.zeros(SLOTS * n_pts),
+        track_depth_shift=np.zeros(SLOTS * n_pts),
         pending=np.zeros(SLOTS * n_pts, dtype=np.int64),
         pending_pair=np.zeros(SLOTS * n_pts, dtype=np.int64),
         release_overlap=np.zeros(SLOTS * n_pts),
@@ -184,16 +194,21 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
     for i in range(int(s.pair_count[0])):
         if s.pair_kind[i] != 0:
             continue
-        fo, ft = int(s.pair_owner_face[i]), int(s.pair_target_face[i])
-        fm = face_map(m, s, sc, fo, ft)
-        if abs(fm.det) < 1e-9:
-            continue
         for k in range(int(s.pair_track_start[i]), int(s.pair_track_stop[i])):
+            # The owner's points on the target face; the target's (kernels.blend) on the owner face.
+            fo, ft = int(s.pair_owner_face[i]), int(s.pair_target_face[i])
+            if k >= s.pair_track_split[i]:
+                fo, ft = ft, fo
+            fm = face_map(m, s, sc, fo, ft)
+            if abs(fm.det) < 1e-9:
+                continue
             p, j = divmod(int(s.track[k]), SLOTS)
-            area, yu, yw = cover(m, sc, p, ft, fm, 0.0)
-            gap = fm.h0 + fm.hu * yu + fm.hw * yw
+            area, yu, yw, shift = cover(m, sc, p, ft, fm, 0.0)
+            gap = fm.h0 + fm.hu * yu + fm.hw * yw - shift
             touching = area > 0.0 and abs(gap) <= m.touch_tol
             s.slot_bonded[p, j] = touching and bool(m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[int(s.slot_partner[p, j])]])
             s.slot_area[p, j] = area
             s.slot_overlap[p, j] = -gap
+        codes = s.track[int(s.pair_track_start[i]) : int(s.pair_track_stop[i])]
+        sc.pair_bonded[i] = codes.size > 0 and bool(s.slot_bonded.reshape(-1)[codes].all())
     return s, sc

@@ -53,6 +53,7 @@ __all__ = [
     "expand_list",
     "expand_random",
     "make_specs",
+    "with_stop",
     "Study",
     "load_study",
     "run_study",
@@ -61,7 +62,7 @@ __all__ = [
     "register_cli",
 ]
 
-TIMING_COLUMNS = ("runtime_s", "wall_s")
+TIMING_COLUMNS = ("runtime_s", "kernel_s", "wall_s", "cpu_s", "beta_search_time_s")
 """Row entries that measure time and therefore differ between otherwise identical runs."""
 
 EXECUTORS = ("process", "serial", "dask")
@@ -217,82 +218,37 @@ def _toml_value(v: Any) -> str:
     raise ValueError(f"override value {v!r} is not a TOML scalar or list")
 
 
-def _block_eta(data: Mapping[str, Any]) -> float | None:
-    sp = data.get("specimen", {})
-    if sp.get("type") == "block" and "width" in sp and "height" in sp:
-        return float(math.atan2(float(sp["width"]), float(sp["height"])))
-    return None
-
-
 def run_spec(spec: RunSpec) -> dict[str, Any]:
-    """Run one spec and return its summary row (pure: same spec -> same row, timings aside).
+    """Run one spec as a single run and return its summary row (pure: same spec -> same row,
+    timings aside). The executors use the batch path (:mod:`rockdem.batch`), which gives the same
+    row without the Dataset; this is the reference it is tested against.
 
     Row keys: ``id``, the inputs (override keys, duration, record, pga_g), ``status`` ("ok", or
     "diverged" with ``diverged_time_s`` when the engine's divergence check cut the run short: the
-    summary then covers the sound part),
-    ``max_rotation_rad``, ``max_rotation_over_eta``, ``overturned``, ``residual_rad``,
-    ``residual_disp_m`` / ``max_disp_m`` (first monitor, horizontal), ``e_a_mean``,
-    ``bounce_max_m_s``, ``failed_shear_fraction``, ``failed_tension_fraction``, ``steps``, ``dt``
-    (the starting timestep), ``dt_min`` (the smallest, after any lowering at contact detections),
-    ``runtime_s`` (engine), ``wall_s`` (whole run), and ``history`` when asked for; with
-    ``damping.beta = "auto"`` or ``"critical"`` also ``beta_s``, ``beta_pairs`` and for "auto"
-    ``beta_target_value``, ``beta_achieved_e_a``, ``beta_iterations``, ``beta_search_time_s``.
+    summary then covers the sound part), with ``run.stop`` on (:mod:`rockdem.stopping`):
+    ``stop_reason`` ("overturned", "fell", "rest", or None for a run that went to its end),
+    ``stop_time_s`` and ``stop_block``; ``max_rotation_rad``, ``max_rotation_over_eta``,
+    ``overturned``, ``residual_rad``, ``residual_disp_m`` / ``max_disp_m`` (first monitor,
+    horizontal), ``e_a_mean``, ``bounce_max_m_s``, ``failed_shear_fraction``,
+    ``failed_tension_fraction``, ``steps``, ``dt`` (the starting timestep), ``dt_min`` (the
+    smallest, after any lowering at contact detections), ``runtime_s`` (engine loop), ``kernel_s``
+    (inside the compiled kernel), ``wall_s`` (whole run), ``cpu_s`` (its processor time), and
+    ``history`` when asked for; with ``damping.beta = "auto"`` or ``"critical"`` also ``beta_s``,
+    ``beta_pairs`` and for "auto" ``beta_target_value``, ``beta_achieved_e_a``, ``beta_iterations``,
+    ``beta_search_time_s`` (the search's time, run once per specimen and damping on the batch path).
     """
-    from .analysis import summarize_result
+    from .batch import frames_from_dataset, summary_row
     from .run_cli import run_case
 
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     data = spec.case_dict()
     case = parse_case(data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = run_case(case, progress=False)
-    eta = _block_eta(data)
-    free = np.flatnonzero(ds.block_free.values)
-    b = int(free[0])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        s = summarize_result(ds, block=b, eta=eta)
-    t = np.asarray(ds.time.values, dtype=float)
-    theta = np.asarray(ds.rocking_angle.values[:, b], dtype=float)
-    a = ds.attrs
-    npts = max(int(a.get("point_count", 1)), 1)
-    row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "diverged" if ds.attrs.get("diverged") else "ok"}
-    if ds.attrs.get("diverged"):
-        row["diverged_time_s"] = float(ds.attrs["diverged_time"])
-    row["max_rotation_rad"] = float(s["max_rotation_rad"])
-    eta = eta or s.get("eta_rad")  # a released assembly: the assembly's angle (summarize_result)
-    row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
-    row["overturned"] = bool(s.get("overturned", False))
-    row["residual_rad"] = float(s["residual_rad"])
-    if ds.sizes.get("monitor", 0):
-        u = np.asarray(ds.monitor_displacement.values[:, 0, :], dtype=float)
-        uh = np.linalg.norm(u[:, :2], axis=1)
-        row["max_disp_m"] = float(uh.max())
-        row["residual_disp_m"] = float(u[-1, 0])
-    row["e_a_mean"] = float(s["e_a_mean"]) if "e_a_mean" in s else None
-    row["bounce_max_m_s"] = float(s["bounce_max_m_s"]) if "bounce_max_m_s" in s else None
-    row["failed_shear_fraction"] = int(ds.contacts_failed_shear.values[-1]) / npts
-    row["failed_tension_fraction"] = int(ds.contacts_failed_tension.values[-1]) / npts
-    row["steps"] = int(a["steps"])
-    row["dt"] = float(a["dt"])
-    row["dt_min"] = float(a["dt_min"])
-    row["runtime_s"] = float(a["runtime_s"])
-    if a.get("beta_mode"):  # an automatic beta: the value chosen and how (rockdem.beta_choice)
-        row["beta_s"] = float(a["beta"])
-        row["beta_pairs"] = str(a["beta_pairs"])
-        for key in ("beta_target_value", "beta_achieved_e_a", "beta_iterations", "beta_search_time_s"):
-            if key in a:
-                row[key] = float(a[key])
-    if spec.history:
-        step = 1
-        if spec.history_interval and len(t) > 1:
-            step = max(1, int(round(spec.history_interval / (t[1] - t[0]))))
-        hist: dict[str, Any] = {"time": t[::step].tolist(), "rotation": theta[::step].tolist()}
-        if ds.sizes.get("monitor", 0):
-            hist["displacement"] = ds.monitor_displacement.values[::step, 0, 0].astype(float).tolist()
-        row["history"] = hist
+    row = summary_row(spec, data, frames_from_dataset(ds))
     row["wall_s"] = time.perf_counter() - t0
+    row["cpu_s"] = time.process_time() - c0
     return row
 
 
@@ -345,7 +301,13 @@ class Store:
 
     def append(self, row: Mapping[str, Any]) -> None:
         """Append one row and make it durable (flush + fsync)."""
-        line = json.dumps(row, separators=(",", ":"), default=_json_default) + "\n"
+        self.extend([row])
+
+    def extend(self, rows: Sequence[Mapping[str, Any]]) -> None:
+        """Append rows (one line each, in one write) and make them durable (flush + fsync)."""
+        if not rows:
+            return
+        line = "".join(json.dumps(row, separators=(",", ":"), default=_json_default) + "\n" for row in rows)
         # a previous interrupted write may have left a partial line: start on a fresh line
         if self.path.exists() and self.path.stat().st_size > 0:
             with self.path.open("rb") as fh:
@@ -397,15 +359,15 @@ def _stop_workers(pool: Any) -> None:
         proc.terminate()
 
 
-def _iter_process(specs: Sequence[RunSpec], workers: int | None, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
+def _iter_process(tasks: Sequence[list[RunSpec]], workers: int | None, fn: Callable[[list[RunSpec]], list[dict]]) -> Iterator[list[dict]]:
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
     n = workers or os.cpu_count() or 1
-    pool = ProcessPoolExecutor(max_workers=min(n, len(specs)), mp_context=mp.get_context("spawn"), initializer=exit_with_parent)
+    pool = ProcessPoolExecutor(max_workers=min(n, len(tasks)), mp_context=mp.get_context("spawn"), initializer=exit_with_parent)
     finished = False
     try:
-        futures = [pool.submit(fn, s) for s in specs]
+        futures = [pool.submit(fn, t) for t in tasks]
         for fut in as_completed(futures):
             yield fut.result()
         finished = True
@@ -415,7 +377,7 @@ def _iter_process(specs: Sequence[RunSpec], workers: int | None, fn: Callable[[R
         pool.shutdown(wait=finished, cancel_futures=True)
 
 
-def _iter_dask(specs: Sequence[RunSpec], scheduler: Any, fn: Callable[[RunSpec], dict]) -> Iterator[dict]:
+def _iter_dask(todo: Sequence[RunSpec], scheduler: Any, fn: Callable[[list[RunSpec]], list[dict]], batch: bool) -> Iterator[list[dict]]:
     try:
         from distributed import Client, as_completed
     except ImportError as exc:  # pragma: no cover - optional extra
@@ -423,8 +385,9 @@ def _iter_dask(specs: Sequence[RunSpec], scheduler: Any, fn: Callable[[RunSpec],
     own = not isinstance(scheduler, Client)
     client = Client(scheduler) if own else scheduler
     try:
-        keys = [f"rockdem-run-{s.id}" for s in specs]
-        futures = client.map(fn, list(specs), key=keys, pure=False)
+        tasks = _tasks(todo, max(1, sum(client.nthreads().values())), batch)
+        keys = [f"rockdem-runs-{hashlib.sha1(''.join(s.id for s in t).encode()).hexdigest()[:16]}" for t in tasks]
+        futures = client.map(fn, list(tasks), key=keys, pure=False)
         try:
             for fut in as_completed(futures):
                 yield fut.result()
@@ -435,6 +398,43 @@ def _iter_dask(specs: Sequence[RunSpec], scheduler: Any, fn: Callable[[RunSpec],
             client.close()
 
 
+MAX_TASK_RUNS = 16
+"""Most runs per task of the process pool or Dask (the batch path): a task's rows reach the store
+when the whole task is done, so a killed sweep recomputes at most this many runs per worker (half
+a second of work for the IDA block of ``benchmarks/bench_ida.py``); a task costs ~1 ms to send."""
+
+TASKS_PER_WORKER = 4
+"""Tasks per worker at least, when there are enough runs (balances runs of unequal length)."""
+
+
+def _single_tasks(specs: list[RunSpec]) -> list[dict]:
+    """A task of the single-run path: :func:`run_spec` per spec, error rows for failures."""
+    return [_safe_run(s) for s in specs]
+
+
+def _tasks(todo: Sequence[RunSpec], workers: int, batch: bool) -> list[list[RunSpec]]:
+    """Split the runs into tasks: by specimen (so that a worker reuses its model), at most
+    :data:`MAX_TASK_RUNS` runs and at least :data:`TASKS_PER_WORKER` tasks per worker."""
+    if not batch:
+        return [[s] for s in todo]
+    from .case import template_key
+
+    keys: dict[str, str] = {}
+    for s in todo:
+        try:
+            keys[s.id] = template_key(s.case_dict())
+        except Exception:  # noqa: BLE001 - a bad spec fails in its task, with its error row
+            keys[s.id] = ""
+    ordered = sorted(todo, key=lambda s: keys[s.id])  # stable: the given order within a specimen
+    size = max(1, min(MAX_TASK_RUNS, math.ceil(len(ordered) / (workers * TASKS_PER_WORKER))))
+    tasks: list[list[RunSpec]] = []
+    for s in ordered:
+        if not tasks or len(tasks[-1]) >= size or keys[tasks[-1][-1].id] != keys[s.id]:
+            tasks.append([])
+        tasks[-1].append(s)
+    return tasks
+
+
 def execute(
     specs: Iterable[RunSpec],
     store: Store | str | os.PathLike[str] | None = None,
@@ -443,6 +443,7 @@ def execute(
     workers: int | None = None,
     scheduler: Any = None,
     progress: bool = True,
+    batch: bool = True,
 ) -> list[dict[str, Any]]:
     """Run the specs not yet finished in ``store``; each finished row is stored at once.
 
@@ -453,9 +454,14 @@ def execute(
         workers: process count for "process" (default: all cores).
         scheduler: Dask scheduler address (or a ``distributed.Client``); implies "dask".
         progress: show a progress bar with ETA (tqdm).
+        batch: run through the batch path (:mod:`rockdem.batch`: one model per specimen and
+            process, no Dataset, many runs per task); False runs :func:`run_spec` per spec. Both
+            give identical rows (timings aside).
 
     Returns:
-        The rows of all specs (stored ones included), in the order of ``specs``.
+        The rows of all specs (stored ones included), in the order of ``specs``. Serial runs reach
+        the store one by one; pool and Dask runs task by task (a task is at most
+        :data:`MAX_TASK_RUNS` runs of one specimen).
     """
     if scheduler is not None:
         executor = "dask"
@@ -474,22 +480,26 @@ def execute(
     results: dict[str, dict[str, Any]] = {i: stored[i] for i in unique if i in done}
     from tqdm.auto import tqdm
 
+    from .batch import run_batch
+
     bar = tqdm(total=len(unique), initial=len(unique) - len(todo), disable=not progress, unit="run", desc="study")
     try:
         if not todo:
             return [results[i] for i in unique]
+        fn = run_batch if batch else _single_tasks
         if executor == "serial":
-            it: Iterator[dict] = (_safe_run(s) for s in todo)
+            it: Iterator[list[dict]] = (fn([s]) for s in todo)
         elif executor == "process":
-            it = _iter_process(todo, workers, _safe_run)
+            it = _iter_process(_tasks(todo, workers or os.cpu_count() or 1, batch), workers, fn)
         else:
-            it = _iter_dask(todo, scheduler, _safe_run)
+            it = _iter_dask(todo, scheduler, fn, batch)
         try:
-            for row in it:
+            for rows in it:
                 if st is not None:
-                    st.append(row)
-                results[row["id"]] = row
-                bar.update(1)
+                    st.extend(rows)  # a task's rows arrive together: one write, one fsync
+                for row in rows:
+                    results[row["id"]] = row
+                bar.update(len(rows))
         finally:
             close = getattr(it, "close", None)
             if close is not None:
@@ -623,12 +633,28 @@ def make_specs(
     duration: float | None = None,
     history: bool = False,
     history_interval: float | None = None,
+    stop: str = "decided",
 ) -> list[RunSpec]:
-    """One spec per variation (``fixed`` overrides are applied to every run)."""
+    """One spec per variation (``fixed`` overrides are applied to every run). ``stop``: the runs'
+    ``run.stop`` (:mod:`rockdem.stopping`; "decided" ends a run once it collapsed or is at rest
+    after its input), unless ``fixed`` or the variation sets it; "off" adds nothing."""
+    fixed = with_stop(fixed, stop)
     return [
-        RunSpec.make(base, {**(fixed or {}), **v}, duration=duration, history=history, history_interval=history_interval)
+        RunSpec.make(base, {**fixed, **v}, duration=duration, history=history, history_interval=history_interval)
         for v in variations
     ]
+
+
+def with_stop(fixed: Mapping[str, Any] | None, stop: str) -> dict[str, Any]:
+    """``fixed`` overrides with ``run.stop = stop`` added unless already set (nothing for "off",
+    so that runs without stopping keep the ids they had before stopping existed)."""
+    from .stopping import stop_rule
+
+    out = dict(fixed or {})
+    stop_rule(stop)  # checks the name
+    if stop != "off":
+        out.setdefault("run.stop", stop)
+    return out
 
 
 def resolve_base(base: str | Mapping[str, Any], relative_to: str | os.PathLike[str] | None = None) -> dict[str, Any]:
@@ -662,7 +688,8 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
     if not isinstance(data, Mapping) or not isinstance(data.get("study"), Mapping):
         raise ValueError("a study file needs a [study] table (base, duration, grid/list/random)")
     s = dict(data["study"])
-    allowed = {"base", "duration", "executor", "workers", "scheduler", "set", "grid", "list", "random", "history", "history_interval", "name"}
+    allowed = {"base", "duration", "executor", "workers", "scheduler", "set", "grid", "list", "random", "history",
+               "history_interval", "name", "stop"}
     unknown = sorted(set(s) - allowed)
     if unknown:
         raise ValueError(f"[study] unknown key(s) {unknown}; accepted keys are {sorted(allowed)}")
@@ -670,7 +697,7 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
         raise ValueError('[study] needs base = "free-rocking" (a built-in example) or a case file path')
     if not isinstance(s["base"], (str, Mapping)):
         raise ValueError(f'[study] base must be a built-in example name or a case file path (a string), got {s["base"]!r}')
-    for key, kind in (("name", str), ("scheduler", str), ("history", bool)):
+    for key, kind in (("name", str), ("scheduler", str), ("history", bool), ("stop", str)):
         if key in s and not isinstance(s[key], kind):
             raise ValueError(f"[study] {key} must be a {'string' if kind is str else 'true or false'}, got {s[key]!r}")
     for key in ("duration", "history_interval"):
@@ -706,9 +733,13 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
         raise ValueError(f"[study] executor must be one of {EXECUTORS}, got {executor!r}")
     if executor == "dask" and not s.get("scheduler"):
         raise ValueError('[study] executor = "dask" needs scheduler = "tcp://HOST:PORT" (or --scheduler)')
+    from .stopping import STOP_MODES
+
+    if s.get("stop", "decided") not in STOP_MODES:
+        raise ValueError(f"[study] stop must be one of {list(STOP_MODES)}, got {s['stop']!r}")
     specs = make_specs(
         base, variations, fixed=fixed, duration=s.get("duration"), history=s.get("history", False),
-        history_interval=s.get("history_interval"),
+        history_interval=s.get("history_interval"), stop=s.get("stop", "decided"),
     )
     return Study(str(s.get("name", name)), specs, executor, workers, s.get("scheduler"), s)
 

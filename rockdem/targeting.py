@@ -176,7 +176,14 @@ def _pair_key(a: str, b: str) -> tuple[str, str]:
     return (a, b) if a <= b else (b, a)
 
 
-def make_probe(builder: ModelBuilder, model: Model, *, fraction: float | None = None, bodies: list[Body] | None = None) -> Probe:
+def make_probe(
+    builder: ModelBuilder,
+    model: Model,
+    *,
+    fraction: float | None = None,
+    bodies: list[Body] | None = None,
+    damping: Damping | None = None,
+) -> Probe:
     """The free-rocking probe of a model (module docstring).
 
     Args:
@@ -185,6 +192,7 @@ def make_probe(builder: ModelBuilder, model: Model, *, fraction: float | None = 
         fraction: release as a fraction of eta; default the model's own release, else
             :data:`DEFAULT_RELEASE_FRACTION`.
         bodies: the model's blocks in their reference pose (default :func:`model_bodies`).
+        damping: the damping whose alpha and local damping the probe keeps (default the model's).
 
     Raises:
         ValueError: no gravity, or the released body rests on nothing.
@@ -221,7 +229,7 @@ def make_probe(builder: ModelBuilder, model: Model, *, fraction: float | None = 
         )
     keep = names + [bodies[k].name for k in sorted(supports)]
     probe_builder, geo = builder.released_copy(names, frac, direction, keep=keep)
-    d = model.damping
+    d = model.damping if damping is None else damping
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the model's own warnings were given when it was finalized
         pm = probe_builder.finalize(
@@ -327,8 +335,12 @@ def _fixed_pairs(model: Model, critical: dict[tuple[str, str], PairBeta], per_in
     return out
 
 
-def choose_beta(builder: ModelBuilder, model: Model) -> BetaChoice:
-    """Resolve ``model.damping.beta`` = ``"critical"`` or ``"auto"`` (called by ``finalize``).
+def choose_beta(builder: ModelBuilder, model: Model, damping: Damping | None = None) -> BetaChoice:
+    """Resolve ``damping.beta`` = ``"critical"`` or ``"auto"`` on ``model`` (called by ``finalize``;
+    ``damping`` defaults to the model's own). Depends on the geometry, materials, gravity, release
+    and contact tolerance of ``builder`` / ``model`` and on ``damping``, not on the loading's
+    ground motion or body acceleration (the probe has none), so a model that differs in these only
+    (:meth:`rockdem.model.Model.with_inputs`) reuses the choice.
 
     Returns:
         The :class:`~rockdem.beta_choice.BetaChoice`: a beta per group pair and how it was found.
@@ -336,7 +348,9 @@ def choose_beta(builder: ModelBuilder, model: Model) -> BetaChoice:
     Raises:
         ValueError: the target cannot be reached, or no probe can be made (the message says why).
     """
-    d: Damping = model.damping
+    d: Damping = model.damping if damping is None else damping
+    if d.beta_mode is None:
+        raise ValueError(f"choose_beta: damping.beta is {d.beta!r}, not 'auto' or 'critical': nothing to choose")
     bodies = model_bodies(model)
     critical = critical_pair_betas(bodies, lambda a, b: model.materials[(a, b)].kn, damping_ratio=d.damping_ratio)
     if d.beta == BETA_CRITICAL:
@@ -344,7 +358,7 @@ def choose_beta(builder: ModelBuilder, model: Model) -> BetaChoice:
         pairs = tuple(fixed.get(k, p) for k, p in sorted(critical.items()))
         return BetaChoice(BETA_CRITICAL, max(p.beta for p in pairs), pairs, per_interface=True)
     t_start = time.perf_counter()
-    probe = make_probe(builder, model, fraction=d.release_fraction, bodies=bodies)
+    probe = make_probe(builder, model, fraction=d.release_fraction, bodies=bodies, damping=d)
     target_spec = RestitutionTarget.parse(d.target_restitution)
     target = target_spec.resolve(probe.geometry.eta)
     fixed_pairs = _fixed_pairs(model, critical, d.per_interface, probe.rocking_pairs)

@@ -10,19 +10,25 @@ Written into ``DIR``:
   blocks.pvd          the time series of the block files (open this one in ParaView).
   contacts_NNNNNN.vtu one per contact snapshot (results run with ``contact_interval``): one vertex
                       cell per sub-contact (interface point with a partner) with point data
-                      normal_force [N], shear_force [N], state (0 bonded, 1 failed in tension,
+                      normal_force [N], shear_force [N] (magnitudes), the vectors normal (unit,
+                      partner face normal into the point's block), normal_force_vector [N] and
+                      shear_force_vector [N] (elastic forces on the point's block, world: ParaView's
+                      Glyph filter draws them as arrows), state (0 bonded, 1 failed in tension,
                       2 failed in shear, 3 unbonded contact), bonded, failed, block, partner, area [m^2].
   contacts.pvd        their time series.
   groups.txt          group_id -> group name.
 
 Arrays are stored inline as base64 binary (UInt64 headers), little-endian, float64 for reals.
-The CLI is ``rockdem export RESULT.nc --vtk DIR``.
+The CLI is ``rockdem export RESULT.nc --vtk DIR`` (``--contacts FILE.csv|.parquet`` writes the contact
+snapshots as a table, :func:`rockdem.results.contact_table`). By default at most
+:data:`DEFAULT_MAX_FILES` block frames are written, evenly spaced (``--every N`` chooses the stride).
 """
 
 from __future__ import annotations
 
 import argparse
 import base64
+import math
 from pathlib import Path
 from typing import Mapping
 from xml.sax.saxutils import quoteattr
@@ -34,12 +40,16 @@ from .cli import positive_int
 from .kernels.rotation import quats_to_matrices
 from .plots import Result, load_result
 
-__all__ = ["VTK_POLYGON", "VTK_VERTEX", "STATE_CODES", "export_vtk", "block_frame_data", "write_vtu", "register_cli"]
+__all__ = ["VTK_POLYGON", "VTK_VERTEX", "STATE_CODES", "DEFAULT_MAX_FILES", "default_every", "export_vtk", "block_frame_data", "write_vtu", "register_cli"]
 
 VTK_VERTEX = 1
 VTK_POLYGON = 7
 STATE_CODES = {0: "bonded", 1: "failed in tension", 2: "failed in shear", 3: "unbonded contact"}
 """Values of the contacts' ``state`` array."""
+
+DEFAULT_MAX_FILES = 501
+"""Most block frames ``rockdem export`` writes unless ``--every`` is given (a 10 s run recorded every
+2 ms has 5,001 frames: every 10th is written)."""
 
 
 
@@ -169,8 +179,17 @@ def _contact_data(ds: xr.Dataset, k: int) -> tuple[np.ndarray, dict[str, np.ndar
     failed = ds.point_failed.values[k, sel].astype(np.int8)
     bonded = ds.point_bonded.values[k, sel].astype(np.int8)
     state = np.where(failed > 0, failed, np.where(bonded > 0, 0, 3)).astype(np.int8)
+    fn = ds.point_normal_force.values[k, sel].astype(np.float64)
+    vectors = {}
+    if "point_normal" in ds:  # results written before the vectors were recorded lack them
+        normal = ds.point_normal.values[k, sel].astype(np.float64)
+        vectors = {
+            "normal": normal,
+            "normal_force_vector": fn[:, None] * normal,
+            "shear_force_vector": ds.point_shear_force_vector.values[k, sel].astype(np.float64),
+        }
     data = {
-        "normal_force": ds.point_normal_force.values[k, sel].astype(np.float64),
+        "normal_force": fn,
         "shear_force": ds.point_shear_force.values[k, sel].astype(np.float64),
         "state": state,
         "bonded": bonded,
@@ -178,8 +197,14 @@ def _contact_data(ds: xr.Dataset, k: int) -> tuple[np.ndarray, dict[str, np.ndar
         "block": ds.point_block.values[sel].astype(np.int32),
         "partner": partner[sel].astype(np.int32),
         "area": ds.point_area.values[sel].astype(np.float64),
+        **vectors,
     }
     return ds.point_position.values[k, sel], data
+
+
+def default_every(frames: int, max_files: int = DEFAULT_MAX_FILES) -> int:
+    """Smallest stride that writes at most ``max_files`` of ``frames`` recorded frames."""
+    return max(1, math.ceil((frames - 1) / max(max_files - 1, 1))) if frames > max_files else 1
 
 
 def export_vtk(result: Result, directory: str | Path, *, every: int = 1, contacts: bool = True) -> Path:
@@ -242,21 +267,38 @@ def read_result_file(path: str | Path) -> xr.Dataset:
 
 
 def _export(args: argparse.Namespace) -> int:
-    if not args.vtk:
-        raise ValueError("export: give --vtk DIR, the folder for the .vtu files and the .pvd series")
-    out = Path(args.vtk)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--vtk {out} is an existing file; give a folder")
-    p = export_vtk(read_result_file(args.result), out, every=args.every, contacts=not args.no_contacts)
-    print(f"rockdem export: wrote {p} (open it in ParaView)")
+    if not args.vtk and not args.contacts:
+        raise ValueError("export: give --vtk DIR (the .vtu files and .pvd series for ParaView) and/or "
+                         "--contacts FILE.csv|.parquet (the contact snapshots as a table)")
+    ds = read_result_file(args.result)
+    if args.contacts:
+        from .results import write_contact_table
+
+        print(f"rockdem export: wrote {write_contact_table(ds, args.contacts)}")
+    if args.vtk:
+        out = Path(args.vtk)
+        if out.exists() and not out.is_dir():
+            raise ValueError(f"--vtk {out} is an existing file; give a folder")
+        n = ds.sizes["time"]
+        every = args.every or default_every(n)
+        p = export_vtk(ds, out, every=every, contacts=not args.no_contacts)
+        shown = len(range(0, n, every))
+        dt = float(np.median(np.diff(ds.time.values))) * every if n > 1 else 0.0
+        note = "" if every == 1 else f" (every {every}th, {dt:.3g} s apart; --every 1 for all)"
+        print(f"rockdem export: wrote {shown} of {n} frames{note} to {p} (open it in ParaView)")
+        if "contact_time" not in ds.coords and not args.no_contacts:
+            print("rockdem export: no contact snapshots in this result: run the case with [run] contact_interval "
+                  "(or --set run.contact_interval=0.05) to export contacts")
     return 0
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``export`` sub-command."""
-    p = subparsers.add_parser("export", help="export a result for ParaView (VTK files and a .pvd series)")
+    p = subparsers.add_parser("export", help="export a result for ParaView (VTK files and a .pvd series) or a contact table")
     p.add_argument("result", metavar="RESULT.nc", help="a result written by rockdem run")
     p.add_argument("--vtk", metavar="DIR", help="folder for blocks_*.vtu, contacts_*.vtu and the .pvd files")
-    p.add_argument("--every", type=positive_int, default=1, help="export every n-th recorded frame (default 1)")
+    p.add_argument("--every", type=positive_int, default=None,
+                   help=f"export every n-th recorded frame (default: at most {DEFAULT_MAX_FILES} frames, evenly spaced)")
     p.add_argument("--no-contacts", action="store_true", help="skip the contact snapshots")
+    p.add_argument("--contacts", metavar="FILE", help="write the contact snapshots as a table (.csv, or .parquet with pyarrow)")
     p.set_defaults(func=_export)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from rockdem.animate import _failed_points, _snapshot, animate, frame_indices, posed_vertices
+from rockdem.animate import _failed_points, _snapshot, _title, animate, frame_indices, playback, posed_vertices
 from rockdem.cli import main
 from rockdem.kernels.rotation import quats_to_matrices, rotation_vector
 from rockdem.plots import world_vertices
@@ -45,13 +45,64 @@ def test_cli_side_view_of_discretised_wall(tmp_path):
     assert len(_frames(out)) == 5
 
 
-def test_mp4_without_ffmpeg_is_a_clear_error(tmp_path, monkeypatch):
-    monkeypatch.setattr("rockdem.animate.shutil.which", lambda name: None)
-    with pytest.raises(ValueError, match="ffmpeg.*not on PATH.*gif"):
+def test_mp4_without_a_system_ffmpeg(tmp_path, monkeypatch):
+    # imageio-ffmpeg's own binary writes the MP4: no ffmpeg on PATH is needed. Read back (with that
+    # binary), the video has every shown frame, the figure's (even) size and the playback rate.
+    import imageio_ffmpeg
+
+    monkeypatch.setenv("PATH", str(tmp_path))  # no system ffmpeg can be found
+    monkeypatch.delenv("IMAGEIO_FFMPEG_EXE", raising=False)
+    ds = example_result()
+    p = animate(ds, tmp_path / "x.mp4", fps=10.0, **LOW)
+    reader = imageio_ffmpeg.read_frames(str(p))
+    meta = reader.__next__()
+    n = sum(1 for _ in reader)
+    play = playback(ds.time.values, fps=10.0, speed=1.0, max_frames=8)  # 2 s in 8 frames: 5 fps, sped up
+    assert n == len(play.frames) == 8
+    assert tuple(meta["size"]) == (160, 120) and meta["fps"] == pytest.approx(play.fps) == 5.0
+
+
+def test_mp4_without_imageio_ffmpeg_is_a_clear_error(tmp_path, monkeypatch):
+    import builtins
+
+    real = builtins.__import__
+
+    def no_imageio_ffmpeg(name, *args, **kwargs):
+        if name == "imageio_ffmpeg":
+            raise ImportError(name)
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_imageio_ffmpeg)
+    with pytest.raises(ValueError, match="imageio-ffmpeg.*gif"):
         animate(example_result(), tmp_path / "x.mp4", **LOW)
     assert not (tmp_path / "x.mp4").exists()
     path = save(example_result(), tmp_path / "ex.nc")
     assert main(["animate", str(path), "-o", str(tmp_path / "x.mp4")]) == 2
+
+
+def test_playback_keeps_real_time_or_says_the_speed_up():
+    # 44 s recorded every 10 ms: 20 fps would need 881 frames. Capped at 300, the rate drops to
+    # 299 / 44 s = 6.8 fps and the playback stays real time: frame k shows t = k / fps.
+    t = np.linspace(0.0, 44.0, 4401)
+    play = playback(t, fps=20.0, speed=1.0, max_frames=300)
+    assert play.speed == 1.0 and not play.sped_up and len(play.frames) <= 300
+    np.testing.assert_allclose(t[play.frames], np.arange(len(play.frames)) / play.fps, atol=0.005)
+    # a GIF holds whole 1/100 s delays: 15 cs per frame, 6.67 fps, still real time
+    gif = playback(t, fps=20.0, speed=1.0, max_frames=300, gif=True)
+    assert gif.fps == pytest.approx(100 / 15) and gif.speed == 1.0 and len(gif.frames) <= 300
+    np.testing.assert_allclose(t[gif.frames], 0.15 * np.arange(len(gif.frames)), atol=0.005)
+    # capped at 100 frames: 5 fps is the floor, so the playback speeds up to 44 x 5 / 99 and says so
+    fast = playback(t, fps=20.0, speed=1.0, max_frames=100)
+    assert fast.fps == 5.0 and fast.speed == pytest.approx(44 * 5 / 99) and fast.sped_up
+    assert "2.22x real time" in fast.note() and len(fast.frames) == 100
+    assert "(2.2x real time)" in _title(example_result(), 10, 1.0, fast.speed)
+
+
+def test_gif_frame_delay_is_the_playback_rate(tmp_path):
+    # 2 s at 20 fps: 41 frames of 50 ms each, playing in real time
+    p = animate(example_result(), tmp_path / "d.gif", fps=20.0, **{**LOW, "max_frames": 50})
+    with Image.open(p) as im:
+        assert im.info["duration"] == 50 and im.n_frames == 41
 
 
 def test_unknown_view_and_suffix_are_refused(tmp_path):

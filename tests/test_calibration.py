@@ -28,7 +28,7 @@ def synthetic(monkeypatch: pytest.MonkeyPatch) -> None:
         return {"id": spec.id, "status": "ok", "beta": dict(spec.overrides)["damping.beta"]}
 
     monkeypatch.setattr(cal, "execute", lambda specs, *a, **k: [row(s) for s in specs])
-    monkeypatch.setattr(cal, "run_spec", row)
+    monkeypatch.setattr(cal, "batch_row", row)  # the optimiser's single steps
     monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: _surface(r["beta"]))
 
 

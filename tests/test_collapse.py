@@ -61,7 +61,7 @@ def test_tilted_drop_conserves_energy():
     assert abs(err) < 0.01
 
 
-SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge"]
+SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge", "tip_over_edge", "corner_near_edge"]
 
 
 @pytest.mark.parametrize("name", SHORT)
@@ -76,6 +76,8 @@ def test_collapse_scenario(name):
         assert float(np.abs(ds.block_velocity.values).max()) == 0.0
     if name == "random_pile":  # comes to rest on the ground
         assert out.final_kinetic < 1e-3 * out.energy_scale
+    if name == "tip_over_edge":  # it tipped over the support's edge and fell off it
+        assert scenarios._lowest_z(sc.model, ds, "block") < 0.3 - 0.05
     if name == "topple_near_edge":  # it toppled (undamped: it bounces) and stays above the foundation
         assert np.max(np.abs(ds.rocking_angle.values[:, 1])) > 1.2
         assert scenarios._lowest_z(sc.model, ds, "block") > -0.02 * 0.25

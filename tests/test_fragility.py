@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.stats import norm
 
@@ -65,7 +66,19 @@ def test_small_ida_on_synthetic_pulse(tmp_path):
         assert not g["failed"].iloc[0] and g["failed"].iloc[-1]  # 0.2 g: no rocking of eta 0.36; 2 g: collapse
     cap = collapse_capacities(df)
     assert cap.notna().all()
-    assert (tmp_path / "ida" / "table.csv").exists() and (tmp_path / "ida" / "ida.png").exists()
+    for name in ("table.csv", "ida.png", "fragility.png", "spectra.png", "report.md", "fragility.csv"):
+        assert (tmp_path / "ida" / name).exists(), name
+    # every run's input has its intensity measures: they grow with the PGA, in proportion
+    # (Arias with its square), and Sa is taken at the block's rocking period
+    for _, g in df.groupby("record"):
+        g = g.sort_values("pga_g")
+        ratio = g["pga_g"] / g["pga_g"].iloc[0]
+        for im, power in (("pgv_m_s", 1), ("sa_g", 1), ("arias_m_s", 2)):
+            np.testing.assert_allclose(g[im] / g[im].iloc[0], ratio**power, rtol=1e-9)
+    assert df["sa_period_s"].iloc[0] == pytest.approx(2 * np.pi / np.sqrt(3 * 9.81 / (4 * np.hypot(0.095, 0.25))))
+    fits = pd.read_csv(tmp_path / "ida" / "fragility.csv")
+    assert list(fits["im"]) == ["pga_g", "pgv_m_s", "arias_m_s", "sa_g"] and (fits["n"] == 8).all()
+    assert "| Sa(T) [g] |" in (tmp_path / "ida" / "report.md").read_text()
 
 
 def _unreadable(tmp_path) -> str:
@@ -102,3 +115,14 @@ def test_all_runs_errored_gives_a_clear_error(tmp_path):
         run_ida("free-rocking", [_unreadable(tmp_path)], [0.2, 0.5], tmp_path / "ida", fixed=FIXED, duration=0.5,
                 executor="serial", progress=False)
     assert (tmp_path / "ida" / "table.csv").exists()  # the table with the errors is kept for inspection
+
+
+def test_a_run_stopped_because_it_collapsed_is_a_failure():
+    """A run stopped as collapsed (a block of an assembly fell) fails even if the analysed block's
+    last rotation is below eta; a run stopped at rest does not."""
+    from rockdem.fragility import failed
+
+    t = pd.DataFrame({"status": ["ok"] * 4, "overturned": [False, False, True, False],
+                      "stop_reason": ["fell", "rest", None, None], "max_rotation_over_eta": [0.2, 0.2, 1.5, 0.7]})
+    assert list(failed(t)) == [True, False, True, False]
+    assert list(failed(t, drift_limit=0.5)) == [True, False, True, True]

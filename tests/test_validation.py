@@ -297,15 +297,15 @@ def test_a_block_falling_off_the_edge_of_its_foundation_falls_on_and_the_run_com
     assert ds.attrs["fell_off_blocks"] == "block"
     t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
     assert 0.3 < t_off < 3.0
-    z = ds.block_position.sel(block=1).values[:, 2]
-    vz = ds.block_velocity.sel(block=1).values[:, 2]
+    z = ds.block_position.sel(block_id=1).values[:, 2]
+    vz = ds.block_velocity.sel(block_id=1).values[:, 2]
     late = ds.time.values > t_off
     # free fall after it left: constant acceleration -g
     acc = np.gradient(vz[late], ds.time.values[late])
     assert np.allclose(acc[2:-2], -9.81, rtol=1e-3)
     assert z[-1] < -2.0
     # the small block stays where it was, resting on the foundation
-    assert abs(float(ds.block_position.sel(block=2).values[-1, 0]) + 0.3) < 1e-3
+    assert abs(float(ds.block_position.sel(block_id=2).values[-1, 0]) + 0.3) < 1e-3
     # no energy created: kinetic + potential + elastic never exceed the initial energy
     mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
     assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81

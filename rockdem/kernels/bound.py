@@ -39,11 +39,12 @@ def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, 
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _add_contact(
-    m: ModelArrays, s: State, sc: Scratch, row: np.ndarray, beta: np.ndarray, o: int, t: int,
+def _contact_rows(
+    m: ModelArrays, s: State, sc: Scratch, beta: np.ndarray, o: int, t: int,
     x0: float, x1: float, x2: float, n0: float, n1: float, n2: float, area: float,
-) -> None:
-    """Add the three springs of a contact at world point x with normal n between blocks o and t."""
+) -> tuple[float, float]:
+    """Row-sum terms (of blocks o and t) of the three springs of a contact at world point x with
+    normal n between blocks o and t; raises their largest beta."""
     go, gt = m.block_group[o], m.block_group[t]
     ro = sc.rotation[o]
     rt = sc.rotation[t]
@@ -58,6 +59,8 @@ def _add_contact(
     w0, w1, w2 = n1 * u2 - n2 * u1, n2 * u0 - n0 * u2, n0 * u1 - n1 * u0
     kn_ = m.mat_kn[go, gt] * area
     ks_ = m.mat_ks[go, gt] * area
+    row_o = 0.0
+    row_t = 0.0
     for dir_ in range(3):
         if dir_ == 0:
             d0, d1, d2, k_ = n0, n1, n2, kn_
@@ -67,11 +70,12 @@ def _add_contact(
             d0, d1, d2, k_ = w0, w1, w2, ks_
         uo = math.sqrt(k_ * _flex(ro, m.block_inv_mass[o], m.block_inv_inertia[o], a0, a1, a2, d0, d1, d2))
         ut = math.sqrt(k_ * _flex(rt, m.block_inv_mass[t], m.block_inv_inertia[t], b0, b1, b2, d0, d1, d2))
-        row[o] += uo * (uo + ut)
-        row[t] += ut * (ut + uo)
+        row_o += uo * (uo + ut)
+        row_t += ut * (ut + uo)
     bt = m.mat_beta[go, gt]
     beta[o] = max(beta[o], bt)
     beta[t] = max(beta[t], bt)
+    return row_o, row_t
 
 
 @njit(cache=True, _nrt=False)
@@ -97,16 +101,25 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, 
             x1 = ra[1, 0] * (va[0] + vb[0]) * 0.5 + ra[1, 1] * (va[1] + vb[1]) * 0.5 + ra[1, 2] * (va[2] + vb[2]) * 0.5 + s.position[a, 1]
             x2 = ra[2, 0] * (va[0] + vb[0]) * 0.5 + ra[2, 1] * (va[1] + vb[1]) * 0.5 + ra[2, 2] * (va[2] + vb[2]) * 0.5 + s.position[a, 2]
             area = min(m.edge_area[ea], m.edge_area[eb])
-            _add_contact(m, s, sc, row, beta, a, b, x0, x1, x2, s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2], area)
+            ra_, rb_ = _contact_rows(m, s, sc, beta, a, b, x0, x1, x2, s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2], area)
+            row[a] += ra_
+            row[b] += rb_
             continue
-        ft = s.pair_target_face[i]
-        t = m.face_block[ft]
-        rt = sc.rotation[t]
-        fn = m.face_normal[ft]
-        n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
-        n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
-        n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
+        # The owner's points and (while the pair may blend, kernels.blend) the target's carry the
+        # shares 1 - lambda and lambda: the pair's stiffness is at most the larger of the two sets'.
+        a = m.face_block[s.pair_owner_face[i]]
+        b = m.face_block[s.pair_target_face[i]]
+        split = s.pair_track_split[i]
+        side_a0 = side_b0 = side_a1 = side_b1 = 0.0
         for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+            # The owner's points press on the target face, the target's on the owner face.
+            ft = s.pair_target_face[i] if k < split else s.pair_owner_face[i]
+            t = m.face_block[ft]
+            rt = sc.rotation[t]
+            fn = m.face_normal[ft]
+            n0 = rt[0, 0] * fn[0] + rt[0, 1] * fn[1] + rt[0, 2] * fn[2]
+            n1 = rt[1, 0] * fn[0] + rt[1, 1] * fn[1] + rt[1, 2] * fn[2]
+            n2 = rt[2, 0] * fn[0] + rt[2, 1] * fn[1] + rt[2, 2] * fn[2]
             p = s.track[k] // SLOTS
             o = m.point_block[p]
             ro = sc.rotation[o]
@@ -114,7 +127,15 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, 
             x0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2] + s.position[o, 0]
             x1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2] + s.position[o, 1]
             x2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2] + s.position[o, 2]
-            _add_contact(m, s, sc, row, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p])
+            r_o, r_t = _contact_rows(m, s, sc, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p])
+            if k < split:
+                side_a0 += r_o
+                side_b0 += r_t
+            else:
+                side_b1 += r_o
+                side_a1 += r_t
+        row[a] += max(side_a0, side_a1)
+        row[b] += max(side_b0, side_b1)
     dt_crit = np.inf
     omega = 0.0
     factor = 1.0

@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .blend import face_clearance, tracks_target
 from .faces import cover, face_map
 from .layout import (
     E_BOND,
@@ -255,6 +256,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
     s.pair_b[i] = b
     s.pair_kind[i] = kind
     s.pair_track_start[i] = ncand
+    s.pair_track_split[i] = ncand
     s.pair_track_stop[i] = ncand
     if kind == PAIR_EDGE:
         ea = _supporting_edge(m, sc, a, da, nx, ny, nz, True)
@@ -294,15 +296,31 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         fo, ft = rface, iface
     s.pair_owner_face[i] = fo
     s.pair_target_face[i] = ft
+    ncand = _face_candidates(m, s, sc, fo, ft, ncand)
+    s.pair_track_split[i] = ncand
+    a_o = m.face_block[fo]
+    a_t = m.face_block[ft]
+    sep_o = face_clearance(m.face_normal, m.face_offset, m.face_block, m.block_vertex_start, m.vertex_local, sc.rotation, s.position, fo, a_t)[0]
+    sep_t = face_clearance(m.face_normal, m.face_offset, m.face_block, m.block_vertex_start, m.vertex_local, sc.rotation, s.position, ft, a_o)[0]
+    if tracks_target(sep_o - sep_t, m.contact_tol):
+        ncand = _face_candidates(m, s, sc, ft, fo, ncand)
+    s.pair_track_stop[i] = ncand
+    return ncand
+
+
+@njit(cache=True, _nrt=False)
+def _face_candidates(m: ModelArrays, s: State, sc: Scratch, fo: int, ft: int, ncand: int) -> int:
+    """Add the points of face ``fo`` whose cells face ``ft`` covers within the tracking tolerance
+    as candidate sub-contacts; returns the new candidate count."""
     fm = face_map(m, s, sc, fo, ft)
     if abs(fm.det) < 1e-9:
         return ncand
     partner = m.face_block[ft]
     for p in range(m.face_point_start[fo], m.face_point_start[fo + 1]):
-        area, yu, yw = cover(m, sc, p, ft, fm, m.contact_tol)
+        area, yu, yw, shift = cover(m, sc, p, ft, fm, m.contact_tol)
         if area <= 0.0:
             continue
-        if fm.h0 + fm.hu * yu + fm.hw * yw > m.contact_tol:
+        if fm.h0 + fm.hu * yu + fm.hw * yw - shift > m.contact_tol:
             continue
         if ncand >= sc.cand_code.shape[0]:
             sc.overflow[0] += 1
@@ -311,7 +329,6 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         sc.cand_partner[ncand] = partner
         sc.cand_face[ncand] = ft
         ncand += 1
-    s.pair_track_stop[i] = ncand
     return ncand
 
 
@@ -397,13 +414,22 @@ def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
         if s.pair_kind[i] != PAIR_FACE:
             continue
         c0 = s.pair_track_start[i]
+        cm = s.pair_track_split[i]
         c1 = s.pair_track_stop[i]
         s.pair_track_start[i] = n
+        bonded = True
         for c in range(c0, c1):
+            if c == cm:
+                s.pair_track_split[i] = n
             if sc.cand_slot[c] >= 0:
-                s.track[n] = SLOTS * sc.cand_code[c] + sc.cand_slot[c]
+                code = SLOTS * sc.cand_code[c] + sc.cand_slot[c]
+                s.track[n] = code
+                bonded = bonded and s.slot_bonded[sc.cand_code[c], sc.cand_slot[c]]
                 n += 1
+        if cm >= c1:
+            s.pair_track_split[i] = n
         s.pair_track_stop[i] = n
+        sc.pair_bonded[i] = bonded and n > s.pair_track_start[i]
     s.track_count[0] = n
 
 

@@ -17,6 +17,7 @@ See ``docs/contacts.md``.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -30,6 +31,10 @@ INSIDE_TOL = 1e-10
 
 DEPTH_TIE = 1e-7
 """[m] covered-cell vertices this close to the deepest count as equally deep."""
+
+OFF_BLEND = 10.0
+"""A point off its target polygon by this many touching tolerances has its force at the deepest
+covered vertex of its cell (the blend towards it starts as the point leaves the polygon)."""
 
 COVER_BLEND = 0.05
 """A cell covered to more than 1 - COVER_BLEND of its area keeps its force at its point (it moves
@@ -184,8 +189,29 @@ def covered(
 def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
-) -> tuple[float, float, float]:
-    """Effective area and force point (u, w) of a cell the target polygon does not wholly cover."""
+    lumped: bool,
+) -> tuple[float, float, float, float]:
+    """Effective area, force point (u, w) and depth shift of a cell the target polygon does not
+    wholly cover.
+
+    The force point: from the point p (or the nearest covered point q when p is off the target)
+    towards the deepest covered vertex d, by w phi'(g): w the cover weight (how much of the cell is
+    uncovered relative to COVER_BLEND, or how far p is off the target), g = u_d - u_p how much
+    deeper d is, phi the ramp smoothed over tau = touch_tol (phi(g) = g^2 / (2 tau) below tau,
+    g - tau / 2 above, phi' = min(g / tau, 1)). The overlap of the sub-contact is
+    u = u_p + w phi(g), whose gradient in the blocks' motion is exactly a unit normal force at that
+    point (for fixed w): the spring is then the gradient of its energy kn A u^2 / 2 and conserves
+    energy as the block rocks. (The overlap at the force point, u_p + w phi'(g) g, is deeper by up
+    to w tau / 2, and made a block tipping over an edge gain energy.) Returns the shift
+    u - overlap at the force point (<= 0).
+
+    With ``lumped`` (unbonded sub-contacts) the effective area is the cell area times the fraction
+    of the cell's *overlapping* part (below the target plane) that the target covers: a tilted
+    corner or edge landing near the partner's edge is as stiff as the same corner landing in the
+    middle of the face (the paper's interface point carries its whole tributary area), and the
+    stiffness still falls continuously to zero as the overlapping part leaves the partner. Where the
+    whole cell overlaps (a flat joint) this is the covered area itself.
+    """
     c0 = cell_start[p]
     nv = cell_start[p + 1] - c0
     for k in range(nv):
@@ -212,6 +238,7 @@ def partly_covered(
             cur = 1 - cur
     area = abs(polygon_area(buf, cur, n)) / abs(fm.det) if n >= 3 else 0.0
     yu, yw = nu, nw
+    shift = 0.0
     if area > 0.0:
         # The force point of a partly covered cell: from the point itself (or the nearest covered
         # point when the point is off the target) towards the deepest covered vertex, as far as that
@@ -228,30 +255,68 @@ def partly_covered(
         du_, dw_ = deepest_vertex(buf, cur, n, gu, gw, nu_, nw_, DEPTH_TIE)
         gain = gu * (nu_ - du_) + gw * (nw_ - dw_)
         uncovered = 1.0 - area / point_area
-        wgt = min(max(gain / touch_tol, 0.0), 1.0) * min(max(uncovered / COVER_BLEND, 0.0), 1.0)
+        # A point off the target is no interface point of this contact any more: the farther off
+        # (relative to the tracking tolerance, 10 touch_tol), the more the force goes to the deepest
+        # covered vertex however little of the cell is uncovered (an edge lying across the
+        # target's boundary is held where it crosses it).
+        off = 0.0 if node_in else math.hypot(nu_ - xu, nw_ - xw) / (OFF_BLEND * touch_tol)
+        cover_w = min(max(uncovered / COVER_BLEND, off, 0.0), 1.0)
+        slope = min(max(gain / touch_tol, 0.0), 1.0)
+        wgt = slope * cover_w
+        if gain > 0.0:  # u_p + w phi(g) minus the overlap at the force point, u_p + w phi'(g) g
+            shift = -cover_w * min(gain, touch_tol) ** 2 / (2.0 * touch_tol)
         if not (node_in and wgt == 0.0):
             tu = nu_ + wgt * (du_ - nu_) - fm.t0
             tw = nw_ + wgt * (dw_ - nw_) - fm.t1
             yu = inv * (fm.m11 * tu - fm.m01 * tw)  # back to owner coordinates
             yw = inv * (-fm.m10 * tu + fm.m00 * tw)
-    return area, yu, yw
+        if lumped:
+            area = _lumped_area(cell_start, cell_vertex, buf, cur, n, point_area, area, p, fm, gu, gw)
+    return area, yu, yw, shift
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float) -> tuple[float, float, float]:
+def _lumped_area(
+    cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.ndarray, cur: int, n: int, point_area: float, area: float,
+    p: int, fm: FaceMap, gu: float, gw: float,
+) -> float:
+    """Cell area x |covered part below the target plane| / |cell part below the target plane|;
+    ``buf[cur, :n]`` holds the covered part (target coordinates, overwritten), gu, gw the height
+    gradient in target coordinates. Falls back to ``area`` where no part of the cell overlaps."""
+    # The overlapping half-plane h < 0: gu u' + gw w' <= -(h0 - gu t0 - gw t1).
+    lo = -(fm.h0 - gu * fm.t0 - gw * fm.t1)
+    m = clip_halfplane(buf, cur, n, gu, gw, lo)
+    covered_below = abs(polygon_area(buf, 1 - cur, m)) / abs(fm.det) if m >= 3 else 0.0
+    c0 = cell_start[p]
+    nv = cell_start[p + 1] - c0
+    for k in range(nv):
+        cu = cell_vertex[c0 + k, 0]
+        cw = cell_vertex[c0 + k, 1]
+        buf[0, k, 0] = fm.m00 * cu + fm.m01 * cw + fm.t0
+        buf[0, k, 1] = fm.m10 * cu + fm.m11 * cw + fm.t1
+    m = clip_halfplane(buf, 0, nv, gu, gw, lo)
+    below = abs(polygon_area(buf, 1, m)) / abs(fm.det) if m >= 3 else 0.0
+    if below <= 1e-12 * point_area:
+        return area
+    return point_area * min(covered_below / below, 1.0)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float) -> tuple[float, float, float, float]:
     """Effective area [m^2] of point p against target face ``ft`` (its cell clipped by the target
     polygon grown by ``grow`` [m]) and where its force acts, (u, w) in owner face coordinates.
 
-    Returns (0, u, w) when the cell is not covered at all. (The work is split into two functions
+    Also returns the depth shift of :func:`partly_covered` (0 for a wholly covered cell); returns
+    (0, u, w, 0) when the cell is not covered at all. (The work is split into two functions
     taking only the arrays they use: Numba compiles such small functions far better than one
     taking the whole model and scratch tuples, 50 ns instead of 1 us per sub-contact.)
     """
     state = covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, grow)
     if state == COVER_FULL:
-        return m.point_area[p], m.point_node[p, 0], m.point_node[p, 1]
+        return m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
     if state == COVER_NONE:
-        return 0.0, m.point_node[p, 0], m.point_node[p, 1]
+        return 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
     return partly_covered(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow,
+        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False,
     )

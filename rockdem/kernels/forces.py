@@ -23,7 +23,8 @@ from .contact import (
     slip_dissipation,
     spring_energy,
 )
-from .faces import COVER_FULL, COVER_NONE, COVER_PART, covered, face_map_arrays, partly_covered
+from .blend import blend_weight, face_clearance, tracks_target
+from .faces import COVER_FULL, COVER_NONE, COVER_PART, FaceMap, covered, face_map_arrays, partly_covered
 from .layout import (
     E_BOND,
     E_FRICTION,
@@ -101,43 +102,73 @@ def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
             c = sc.pair_point[i]
             _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, s.pair_a[i], s.pair_b[i], f[0], f[1], f[2], c[0], c[1], c[2])
             continue
-        o = m.face_block[s.pair_owner_face[i]]
-        t = m.face_block[s.pair_target_face[i]]
+        a = m.face_block[s.pair_owner_face[i]]
+        b = m.face_block[s.pair_target_face[i]]
+        split = s.pair_track_split[i]
         for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
             f0 = sc.contact_force[k, 0]
             f1 = sc.contact_force[k, 1]
             f2 = sc.contact_force[k, 2]
             if f0 != 0.0 or f1 != 0.0 or f2 != 0.0:
+                o, t = (a, b) if k < split else (b, a)
                 _apply(
                     s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f0, f1, f2,
                     sc.contact_point[k, 0], sc.contact_point[k, 1], sc.contact_point[k, 2],
                 )
+        if sc.pair_weight[i] > 0.0 and sc.pair_weight[i] < 1.0:
+            f = sc.blend_force_owner[i]
+            c = sc.blend_point_owner[i]
+            _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, a, b, f[0], f[1], f[2], c[0], c[1], c[2])
+            f = sc.blend_force_target[i]
+            c = sc.blend_point_target[i]
+            _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, b, a, f[0], f[1], f[2], c[0], c[1], c[2])
 
 
 @njit(cache=True, _nrt=False)
 def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
-    """Effective area and force point (``sc.track_cover``) of every sub-contact whose cell its target
+    """Effective area and force point (``sc.track_area``, ``sc.track_point_u``, ``sc.track_point_w``, ``sc.track_depth_shift``) of every sub-contact whose cell its target
     face wholly covers (zero area for faces at right angles); the others are listed in
     ``sc.pending`` for :func:`_partial_pass`. Returns how many are listed."""
     npend = 0
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
-        fo = s.pair_owner_face[i]
-        ft = s.pair_target_face[i]
-        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        flat = abs(fm.det) < 1e-9
-        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-            p = s.track[k] // SLOTS
-            state = COVER_NONE if flat else covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, 0.0)
-            if state != COVER_PART:
-                sc.track_cover[k, 0] = m.point_area[p] if state == COVER_FULL else 0.0
-                sc.track_cover[k, 1] = m.point_node[p, 0]
-                sc.track_cover[k, 2] = m.point_node[p, 1]
-            else:
-                sc.pending[npend] = k
-                sc.pending_pair[npend] = i
-                npend += 1
+        split = s.pair_track_split[i]
+        for side in range(2):
+            k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
+            if k0 == k1:
+                continue
+            fo, ft = _faces(s, i, side)
+            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+            npend = _cover_range(m, s, sc, i, k0, k1, ft, fm, npend)
+    return npend
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _faces(s: State, i: int, side: int) -> tuple[int, int]:
+    """(face whose points press, face they press on) of FACE pair i: the owner's points on the
+    target (side 0) or the target's points on the owner (side 1, kernels.blend)."""
+    if side == 0:
+        return s.pair_owner_face[i], s.pair_target_face[i]
+    return s.pair_target_face[i], s.pair_owner_face[i]
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _cover_range(m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, ft: int, fm: FaceMap, npend: int) -> int:
+    """The wholly covered (or uncovered) sub-contacts track[k0:k1] pressed on face ``ft``."""
+    flat = abs(fm.det) < 1e-9
+    for k in range(k0, k1):
+        p = s.track[k] // SLOTS
+        state = COVER_NONE if flat else covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, 0.0)
+        if state != COVER_PART:
+            sc.track_area[k] = m.point_area[p] if state == COVER_FULL else 0.0
+            sc.track_point_u[k] = m.point_node[p, 0]
+            sc.track_point_w[k] = m.point_node[p, 1]
+            sc.track_depth_shift[k] = 0.0
+        else:
+            sc.pending[npend] = k
+            sc.pending_pair[npend] = i
+            npend += 1
     return npend
 
 
@@ -147,17 +178,19 @@ def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
     for q in range(npend):
         k = sc.pending[q]
         i = sc.pending_pair[q]
-        fo = s.pair_owner_face[i]
-        ft = s.pair_target_face[i]
+        fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
         fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        p = s.track[k] // SLOTS
-        area, yu, yw = partly_covered(
+        code = s.track[k]
+        p = code // SLOTS
+        area, yu, yw, shift = partly_covered(
             m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
             m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0,
+            not s.slot_bonded[p, code - SLOTS * p],
         )
-        sc.track_cover[k, 0] = area
-        sc.track_cover[k, 1] = yu
-        sc.track_cover[k, 2] = yw
+        sc.track_area[k] = area
+        sc.track_point_u[k] = yu
+        sc.track_point_w[k] = yw
+        sc.track_depth_shift[k] = shift
 
 
 @njit(cache=True, _nrt=False)
@@ -180,140 +213,225 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
-        fo = s.pair_owner_face[i]
-        ft = s.pair_target_face[i]
-        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        o = m.face_block[fo]
-        t = m.face_block[ft]
-        go = m.block_group[o]
-        gt = m.block_group[t]
-        kn = m.mat_kn[go, gt]
-        ks = m.mat_ks[go, gt]
-        beta = m.mat_beta[go, gt]
-        n0, n1, n2 = fm.nx, fm.ny, fm.nz
-        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-            code = s.track[k]
-            p = code // SLOTS
-            j = code - SLOTS * p
-            sc.dashpot_force[k, 0] = 0.0
-            sc.dashpot_force[k, 1] = 0.0
-            sc.dashpot_force[k, 2] = 0.0
-            sc.contact_force[k, 0] = 0.0
-            sc.contact_force[k, 1] = 0.0
-            sc.contact_force[k, 2] = 0.0
-            area = sc.track_cover[k, 0]
-            yu = sc.track_cover[k, 1]
-            yw = sc.track_cover[k, 2]
-            un = -(fm.h0 + fm.hu * yu + fm.hw * yw)
-            un_prev = s.slot_overlap[p, j]
-            s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
-            us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
-            bonded = s.slot_bonded[p, j]
-            prev_area = s.slot_area[p, j]
-            s.slot_area[p, j] = area
-            # Contact point: midway between the owner-plane point and the target plane.
-            x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
-            x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
-            x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
-            v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
-            vn = v0 * n0 + v1 * n1 + v2 * n2  # > 0: separating
-            vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
-            kna = kn * area
-            ksa = ks * area
-            fn = kna * un
-            opened = area <= 0.0 or (un <= 0.0 and not bonded)
-            if not opened and bonded and fn < -m.mat_tension[go, gt] * area:
-                # Tension cut-off: the bond fails and the point opens.
-                e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+        fa = s.pair_owner_face[i]
+        fb = s.pair_target_face[i]
+        a = m.face_block[fa]
+        b = m.face_block[fb]
+        split = s.pair_track_split[i]
+        stop = s.pair_track_stop[i]
+        lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
+        # The owner's points on the target face, then (while the pair may blend) the target's on
+        # the owner face.
+        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel)
+        elastic += el
+        active += ac
+        e_fric += ef
+        e_bond += eb
+        if split < stop:
+            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel)
+            elastic += el
+            active += ac
+            e_fric += ef
+            e_bond += eb
+            if dlam != 0.0:
+                # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
+                g = (u_target - u_owner) * dlam
+                for c in range(3):
+                    sc.blend_force_owner[i, c] *= g
+                    sc.blend_force_target[i, c] *= g
+    return elastic, active, e_fric, e_bond, nrel
+
+
+@njit(cache=True, _nrt=False)
+def _law_range(
+    m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
+    wgt: float, blending: bool, dt: float, nrel: int,
+) -> tuple[float, int, float, float, int, float]:
+    """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
+    pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
+    False: the whole pair, wgt 1). Returns (elastic energy, active count, friction and bond energy
+    dissipated, the new opened count, the normal spring energy at full share)."""
+    elastic = 0.0
+    active = 0
+    e_fric = 0.0
+    e_bond = 0.0
+    u_side = 0.0
+    fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+    go = m.block_group[o]
+    gt = m.block_group[t]
+    kn = m.mat_kn[go, gt]
+    ks = m.mat_ks[go, gt]
+    beta = m.mat_beta[go, gt]
+    n0, n1, n2 = fm.nx, fm.ny, fm.nz
+    for k in range(k0, k1):
+        code = s.track[k]
+        p = code // SLOTS
+        j = code - SLOTS * p
+        sc.dashpot_force[k, 0] = 0.0
+        sc.dashpot_force[k, 1] = 0.0
+        sc.dashpot_force[k, 2] = 0.0
+        sc.contact_force[k, 0] = 0.0
+        sc.contact_force[k, 1] = 0.0
+        sc.contact_force[k, 2] = 0.0
+        full_area = sc.track_area[k]
+        area = full_area
+        if blending:  # this side's share (kernels.blend); 0 switches it off
+            area *= wgt
+            sc.track_area[k] = area
+        yu = sc.track_point_u[k]
+        yw = sc.track_point_w[k]
+        un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + sc.track_depth_shift[k]
+        un_prev = s.slot_overlap[p, j]
+        s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
+        us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
+        bonded = s.slot_bonded[p, j]
+        prev_area = s.slot_area[p, j]
+        s.slot_area[p, j] = area
+        # Contact point: midway between the owner-plane point and the target plane.
+        x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
+        x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
+        x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
+        v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
+        vn = v0 * n0 + v1 * n1 + v2 * n2  # > 0: separating
+        vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+        kna = kn * area
+        ksa = ks * area
+        fn = kna * un
+        opened = area <= 0.0 or (un <= 0.0 and not bonded)
+        if not opened and bonded and fn < -m.mat_tension[go, gt] * area:
+            # Tension cut-off: the bond fails and the point opens.
+            e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+            s.slot_bonded[p, j] = False
+            s.point_failed[p] = FAILED_TENSION
+            opened = True
+            bonded = False
+            prev_area = 0.0  # its energy is counted
+        if opened:
+            # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
+            e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
+            if bonded:
+                e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
                 s.slot_bonded[p, j] = False
-                s.point_failed[p] = FAILED_TENSION
-                opened = True
-                bonded = False
-                prev_area = 0.0  # its energy is counted
-            if opened:
-                # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
-                e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
-                if bonded:
-                    e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
-                    s.slot_bonded[p, j] = False
-                    s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
-                elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
-                    # Opened during the last step: its release is computed apart (release pass), its
-                    # shear extension kept until then.
-                    sc.pending[nrel] = k
-                    sc.pending_pair[nrel] = i
-                    sc.release_overlap[nrel] = un_prev
-                    sc.release_area[nrel] = prev_area
-                    nrel += 1
-                    s.slot_normal_force[p, j] = 0.0
-                    continue
-                else:
-                    e_fric += e
-                s.slot_shear[p, j, 0] = 0.0
-                s.slot_shear[p, j, 1] = 0.0
-                s.slot_shear[p, j, 2] = 0.0
+                s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
+            elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
+                # Opened during the last step: its release is computed apart (release pass), its
+                # shear extension kept until then.
+                sc.pending[nrel] = k
+                sc.pending_pair[nrel] = i
+                sc.release_overlap[nrel] = un_prev
+                sc.release_area[nrel] = prev_area
+                nrel += 1
                 s.slot_normal_force[p, j] = 0.0
                 continue
-            # An unbonded contact that closed during the last step: its springs act since the crossing
-            # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
-            ramp = 1.0
-            since = dt
-            if not bonded and un_prev <= 0.0 and vn < 0.0:
-                since = min(un / (-vn * dt), 1.0) * dt
-                ramp = ramp_overlap(un, un_prev, vn, dt) / un
-            f_applied = fn * ramp
-            us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
-            trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
-            if bonded:
-                fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
             else:
-                fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
-            slipping = trial > fmax
-            gone = False
-            if slipping:
-                e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
-                if bonded:
-                    # Shear failure: drop to the residual strength; the released energy is the bond's.
-                    s.slot_bonded[p, j] = False
-                    s.point_failed[p] = FAILED_SHEAR
-                    fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
-                    e_bond += drop_dissipation(fmax, fres, ksa)
-                    fmax = fres
-                    if un <= 0.0:  # held only by the bond: it opens
-                        e_bond += spring_energy(fn, kna) + spring_energy(fmax, ksa)
-                        gone = True
-                f = fmax / trial if trial > 0.0 else 0.0
-                us0 *= f
-                us1 *= f
-                us2 *= f
-            if gone:
-                us0 = us1 = us2 = fn = 0.0
-            s.slot_shear[p, j, 0] = us0
-            s.slot_shear[p, j, 1] = us1
-            s.slot_shear[p, j, 2] = us2
-            s.slot_normal_force[p, j] = fn
-            if gone:
-                continue
-            elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
-            active += 1
-            # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
-            # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
-            fdn = -beta * kna * vn
-            bs = 0.0 if slipping else beta * ksa
-            d0 = fdn * n0 - bs * vs0
-            d1 = fdn * n1 - bs * vs1
-            d2 = fdn * n2 - bs * vs2
-            sc.dashpot_force[k, 0] = d0
-            sc.dashpot_force[k, 1] = d1
-            sc.dashpot_force[k, 2] = d2
-            fs = ksa * ramp
-            _store(
-                sc.contact_force, sc.contact_point, k,
-                f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
-                x0, x1, x2,
-            )
+                e_fric += e
+            s.slot_shear[p, j, 0] = 0.0
+            s.slot_shear[p, j, 1] = 0.0
+            s.slot_shear[p, j, 2] = 0.0
+            s.slot_normal_force[p, j] = 0.0
+            continue
+        # An unbonded contact that closed during the last step: its springs act since the crossing
+        # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
+        ramp = 1.0
+        since = dt
+        if not bonded and un_prev <= 0.0 and vn < 0.0:
+            since = min(un / (-vn * dt), 1.0) * dt
+            ramp = ramp_overlap(un, un_prev, vn, dt) / un
+        f_applied = fn * ramp
+        us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
+        trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
+        if bonded:
+            fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
+        else:
+            fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
+        slipping = trial > fmax
+        gone = False
+        if slipping:
+            e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
+            if bonded:
+                # Shear failure: drop to the residual strength; the released energy is the bond's.
+                s.slot_bonded[p, j] = False
+                s.point_failed[p] = FAILED_SHEAR
+                fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
+                e_bond += drop_dissipation(fmax, fres, ksa)
+                fmax = fres
+                if un <= 0.0:  # held only by the bond: it opens
+                    e_bond += spring_energy(fn, kna) + spring_energy(fmax, ksa)
+                    gone = True
+            f = fmax / trial if trial > 0.0 else 0.0
+            us0 *= f
+            us1 *= f
+            us2 *= f
+        if gone:
+            us0 = us1 = us2 = fn = 0.0
+        s.slot_shear[p, j, 0] = us0
+        s.slot_shear[p, j, 1] = us1
+        s.slot_shear[p, j, 2] = us2
+        s.slot_normal_force[p, j] = fn
+        if gone:
+            continue
+        elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
+        if blending:
+            u_side += 0.5 * kn * full_area * un * un
+        active += 1
+        # Stiffness-proportional dashpots on the active sub-contact (paper Eq. 4, alpha = 0 part).
+        # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
+        fdn = -beta * kna * vn
+        bs = 0.0 if slipping else beta * ksa
+        d0 = fdn * n0 - bs * vs0
+        d1 = fdn * n1 - bs * vs1
+        d2 = fdn * n2 - bs * vs2
+        sc.dashpot_force[k, 0] = d0
+        sc.dashpot_force[k, 1] = d1
+        sc.dashpot_force[k, 2] = d2
+        fs = ksa * ramp
+        _store(
+            sc.contact_force, sc.contact_point, k,
+            f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
+            x0, x1, x2,
+        )
+    return elastic, active, e_fric, e_bond, nrel, u_side
 
-    return elastic, active, e_fric, e_bond, nrel
+
+@njit(cache=True, _nrt=False)
+def _blend(m: ModelArrays, s: State, sc: Scratch, i: int, fa: int, fb: int, a: int, b: int, split: int) -> tuple[float, float]:
+    """Share lambda of the target face's points of FACE pair i and d lambda / d clarity
+    (:mod:`rockdem.kernels.blend`); leaves in ``sc.blend_*`` the unit force pairs of -grad c
+    (scaled by (U_t - U_o) lambda' once the spring energies are known) and asks for a detection
+    when the target's points are needed but not tracked."""
+    sc.pair_weight[i] = 0.0
+    if sc.pair_bonded[i] or s.pair_track_start[i] == s.pair_track_stop[i]:
+        return 0.0, 0.0  # a joint (flush) or nothing tracked: the detection tracks what comes near
+    sep_o, v0, v1, v2, na0, na1, na2 = face_clearance(
+        m.face_normal, m.face_offset, m.face_block, m.block_vertex_start, m.vertex_local, sc.rotation, s.position, fa, b
+    )
+    sep_t, w0, w1, w2, nb0, nb1, nb2 = face_clearance(
+        m.face_normal, m.face_offset, m.face_block, m.block_vertex_start, m.vertex_local, sc.rotation, s.position, fb, a
+    )
+    clarity = sep_o - sep_t
+    if split == s.pair_track_stop[i]:
+        if tracks_target(clarity, m.contact_tol):  # not tracked yet: detect at the next step
+            s.moved[a] = max(s.moved[a], m.contact_tol)
+            s.moved[b] = max(s.moved[b], m.contact_tol)
+        return 0.0, 0.0
+    lam, dlam = blend_weight(clarity, m.contact_tol)
+    sc.pair_weight[i] = lam
+    # -grad c = -grad sep_o + grad sep_t: sep_o grows with the target's vertex v moving out of the
+    # owner face along n_o (a unit force n_o on the target's block at v, -n_o on the owner's);
+    # sep_t likewise with the owner's vertex w along n_t.
+    sc.blend_force_owner[i, 0] = na0
+    sc.blend_force_owner[i, 1] = na1
+    sc.blend_force_owner[i, 2] = na2
+    sc.blend_point_owner[i, 0] = v0
+    sc.blend_point_owner[i, 1] = v1
+    sc.blend_point_owner[i, 2] = v2
+    sc.blend_force_target[i, 0] = -nb0
+    sc.blend_force_target[i, 1] = -nb1
+    sc.blend_force_target[i, 2] = -nb2
+    sc.blend_point_target[i, 0] = w0
+    sc.blend_point_target[i, 1] = w1
+    sc.blend_point_target[i, 2] = w2
+    return lam, dlam
 
 
 @njit(cache=True, _nrt=False)
@@ -327,8 +445,7 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
         i = sc.pending_pair[q]
         un_prev = sc.release_overlap[q]
         prev_area = sc.release_area[q]
-        fo = s.pair_owner_face[i]
-        ft = s.pair_target_face[i]
+        fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
         fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
         o = m.face_block[fo]
         t = m.face_block[ft]
@@ -338,10 +455,10 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
         ks = m.mat_ks[go, gt]
         p = s.track[k] // SLOTS
         j = s.track[k] - SLOTS * p
-        area = sc.track_cover[k, 0]
-        yu = sc.track_cover[k, 1]
-        yw = sc.track_cover[k, 2]
-        un = -(fm.h0 + fm.hu * yu + fm.hw * yw)
+        area = sc.track_area[k]
+        yu = sc.track_point_u[k]
+        yw = sc.track_point_w[k]
+        un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + sc.track_depth_shift[k]
         n0, n1, n2 = fm.nx, fm.ny, fm.nz
         x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
         x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1

@@ -165,7 +165,10 @@ class State(NamedTuple):
     pair_kind: np.ndarray  # (P,) int64 PAIR_FACE or PAIR_EDGE
     pair_owner_face: np.ndarray  # (P,) int64 FACE: face whose points carry the sub-contacts
     pair_target_face: np.ndarray  # (P,) int64 FACE: face they press on
-    pair_track_start: np.ndarray  # (P,) int64 FACE: its sub-contacts are track[start:stop]
+    pair_track_start: np.ndarray  # (P,) int64 FACE: its sub-contacts are track[start:stop], the owner
+    # face's points pressed on the target face in [start, split), the target face's points pressed on
+    # the owner face in [split, stop) (tracked only while the pair may blend, kernels.blend)
+    pair_track_split: np.ndarray  # (P,) int64
     pair_track_stop: np.ndarray  # (P,) int64
     pair_edge_a: np.ndarray  # (P,) int64 EDGE: edge of block a
     pair_edge_b: np.ndarray  # (P,) int64 EDGE: edge of block b
@@ -200,8 +203,10 @@ class Scratch(NamedTuple):
     contact_force: np.ndarray  # (SLOTS np, 3) [N] force of each tracked sub-contact on its owner, world
     contact_point: np.ndarray  # (SLOTS np, 3) [m] its point of application, world
     dashpot_force: np.ndarray  # (SLOTS np, 3) [N] the SP dashpot part of that force
-    track_cover: np.ndarray  # (SLOTS np, 3) effective area [m^2] and force point (u, w) [m] of each
-    # tracked sub-contact (owner face coordinates)
+    track_area: np.ndarray  # (SLOTS np,) [m^2] effective area of each tracked sub-contact
+    track_point_u: np.ndarray  # (SLOTS np,) [m] its force point, owner face coordinate u
+    track_point_w: np.ndarray  # (SLOTS np,) [m] ... and w
+    track_depth_shift: np.ndarray  # (SLOTS np,) [m] overlap at the force point minus its overlap (<= 0, faces.partly_covered)
     pending: np.ndarray  # (SLOTS np,) int64 tracked sub-contacts left for a later pass
     pending_pair: np.ndarray  # (SLOTS np,) int64 their pairs
     release_overlap: np.ndarray  # (SLOTS np,) [m] overlap at the previous step of each opened one
@@ -209,6 +214,12 @@ class Scratch(NamedTuple):
     pair_force: np.ndarray  # (P, 3) [N] EDGE pairs: force on block a
     pair_point: np.ndarray  # (P, 3) [m] its point of application
     pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: the SP dashpot part
+    pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
+    pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
+    blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
+    blend_point_owner: np.ndarray  # (P, 3) [m] ... at this point (minus it on the target's block)
+    blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block
+    blend_point_target: np.ndarray  # (P, 3) [m] ... at this point (minus it on the owner's block)
     velocity_mid: np.ndarray  # (nb, 3) [m/s] step mid-point velocity
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
     poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)

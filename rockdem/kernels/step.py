@@ -207,13 +207,17 @@ def dashpot_work(m: ModelArrays, s: State, sc: Scratch, h: float) -> None:
             if fd[0] != 0.0 or fd[1] != 0.0 or fd[2] != 0.0:
                 e += _dashpot_power(s, sc, s.pair_a[i], s.pair_b[i], fd, sc.pair_point[i]) * h
             continue
-        o = m.face_block[s.pair_owner_face[i]]
-        t = m.face_block[s.pair_target_face[i]]
+        a = m.face_block[s.pair_owner_face[i]]
+        b = m.face_block[s.pair_target_face[i]]
+        split = s.pair_track_split[i]
         for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
             fd = sc.dashpot_force[k]
             if fd[0] == 0.0 and fd[1] == 0.0 and fd[2] == 0.0:
                 continue
-            e += _dashpot_power(s, sc, o, t, fd, sc.contact_point[k]) * h
+            if k < split:
+                e += _dashpot_power(s, sc, a, b, fd, sc.contact_point[k]) * h
+            else:  # the target face's points (kernels.blend): the force acts on the target's block
+                e += _dashpot_power(s, sc, b, a, fd, sc.contact_point[k]) * h
     s.energy[E_DAMPING_STIFFNESS] += e
 
 

@@ -1,0 +1,255 @@
+"""The batch path of studies: summary rows of many runs without what a single run needs.
+
+A single run (:func:`rockdem.studies.run_spec`, ``rockdem run``) parses its case, builds its model,
+runs it, assembles the full xarray Dataset (and saves it) and summarises that. A study wants only
+the summary row, many times over models that differ in a record, a scale factor or a damping value.
+:func:`run_batch` keeps, per process, a :class:`rockdem.case.CaseTemplate` per distinct specimen
+(:func:`rockdem.case.template_key`): the next run of the same specimen swaps its damping and input
+arrays (ground motion, body acceleration) into the model's ``ModelArrays`` instead of rebuilding
+blocks, interface points and contact geometry; ground-motion files are read once per process. It
+runs :func:`rockdem.simulation.run_model` (no Dataset, no NetCDF) and summarises the raw frames.
+
+Both paths build their rows with :func:`summary_row` on :class:`Frames` computed by the same
+functions (:func:`rockdem.results.reference_rotations` and friends, called by ``build_dataset`` as
+well), from the same models (``CaseTemplate.derive`` gives :func:`rockdem.case.parse_case`'s
+arrays), so a spec's row is identical, bit for bit (timings aside), whichever path computed it
+(``tests/test_batch.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+import warnings
+from collections import OrderedDict
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from .analysis import eta_of, lowest_vertex_height, summarize
+from .case import Case, CaseTemplate, template_key
+from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION
+from .results import block_eta, damping_attrs, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
+
+__all__ = ["Frames", "frames_from_dataset", "frames_from_run", "summary_row", "run_batch", "batch_row", "case_of", "TEMPLATE_CACHE"]
+
+TEMPLATE_CACHE = 16
+"""Case templates (distinct specimens) kept per process."""
+
+_TEMPLATES: OrderedDict[str, CaseTemplate] = OrderedDict()
+_LOCK = threading.Lock()  # Dask workers may run several tasks in threads
+
+
+class Frames(NamedTuple):
+    """What a summary row reads of a run (T recorded frames, nb blocks, nm monitors).
+
+    Attributes:
+        time: (T,) [s].
+        rocking: (T, nb) rotation about the rocking axis [rad].
+        position: (T, nb, 3) centroids [m].
+        quaternion: (T, nb, 4) orientations.
+        monitor: (T, nm, 3) monitor displacements relative to the ground [m].
+        failed_shear, failed_tension: sub-contacts failed at the last frame.
+        block_free: (nb,) bool.
+        block_eta: (nb,) instability angle of each free block [rad] (NaN for driven ones).
+        vertex_local: (nv, 3) vertices in the body frames [m]; block_vertex_start: (nb+1,).
+        attrs: the result's attributes (steps, dt, runtime_s, diverged..., stop_reason..., the loading's).
+    """
+
+    time: np.ndarray
+    rocking: np.ndarray
+    position: np.ndarray
+    quaternion: np.ndarray
+    monitor: np.ndarray
+    failed_shear: int
+    failed_tension: int
+    block_free: np.ndarray
+    block_eta: np.ndarray
+    vertex_local: np.ndarray
+    block_vertex_start: np.ndarray
+    attrs: Mapping[str, Any]
+
+
+def frames_from_dataset(ds: Any) -> Frames:
+    """The frames of a result Dataset (a single run, or a result file read back)."""
+    return Frames(
+        np.asarray(ds.time.values, dtype=float), ds.rocking_angle.values, ds.block_position.values,
+        ds.block_quaternion.values, ds.monitor_displacement.values, int(ds.contacts_failed_shear.values[-1]),
+        int(ds.contacts_failed_tension.values[-1]), np.asarray(ds.block_free.values, dtype=bool),
+        ds.block_eta.values if "block_eta" in ds else np.full(ds.sizes["block"], np.nan),
+        ds.vertex_local.values, ds.block_vertex_start.values, dict(ds.attrs),
+    )
+
+
+def frames_from_run(case: Case, out: Any) -> Frames:
+    """The frames of a :func:`rockdem.simulation.run_model` output, computed as
+    :func:`rockdem.results.build_dataset` computes them; attrs as ``run_case`` gives them."""
+    model, rec = case.model, out.records
+    rel_ref, rotvec = reference_rotations(model, rec.quaternion)
+    u_ground = ground_displacement(model, rec.position)
+    mon = monitor_displacements(model, rel_ref, rec.position, out.monitors) - u_ground[:, None]
+    m = model.arrays
+    attrs = {**out.attrs, **damping_attrs(model), "point_count": model.point_count, **case.attrs}
+    return Frames(
+        rec.time, rocking_angles(model, rotvec), rec.position, rec.quaternion, mon, int(rec.counts[-1, COUNT_FAILED_SHEAR]),
+        int(rec.counts[-1, COUNT_FAILED_TENSION]), np.asarray(m.block_free, dtype=bool), block_eta(model),
+        m.vertex_local, m.block_vertex_start, attrs,
+    )
+
+
+def _specimen_eta(data: Mapping[str, Any]) -> float | None:
+    """atan(width / height) of a ``block`` specimen, else None."""
+    sp = data.get("specimen", {})
+    if sp.get("type") == "block" and "width" in sp and "height" in sp:
+        return float(np.arctan2(float(sp["width"]), float(sp["height"])))
+    return None
+
+
+def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]:
+    """The summary row of a run of ``spec`` (a :class:`rockdem.studies.RunSpec`) with case dict
+    ``data`` (keys: see :func:`rockdem.studies.run_spec`); ``wall_s`` is added by the caller."""
+    free = np.flatnonzero(f.block_free)
+    b = int(free[0])
+    t = f.time
+    theta = np.asarray(f.rocking[:, b], dtype=float)
+    eta = _specimen_eta(data)
+    eta_used = eta if eta is not None else eta_of(f.attrs, f.block_eta, b)
+    starts = f.block_vertex_start
+    z = lowest_vertex_height(f.position[:, b], f.quaternion[:, b], f.vertex_local[starts[b] : starts[b + 1]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s = summarize(t, theta, eta=eta_used, z=z)
+    a = f.attrs
+    npts = max(int(a.get("point_count", 1)), 1)
+    row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "diverged" if a.get("diverged") else "ok"}
+    if a.get("diverged"):
+        row["diverged_time_s"] = float(a["diverged_time"])
+    if a.get("stop_rule", "off") != "off":
+        row["stop_reason"] = a.get("stop_reason")
+        row["stop_time_s"] = float(a["stop_time"]) if a.get("stop_reason") else None
+        if a.get("stop_reason") in ("overturned", "fell"):
+            row["stop_block"] = a.get("stop_block")
+    row["max_rotation_rad"] = float(s["max_rotation_rad"])
+    eta = eta or s.get("eta_rad")  # a released assembly: the assembly's angle
+    row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
+    row["overturned"] = bool(s.get("overturned", False))
+    row["residual_rad"] = float(s["residual_rad"])
+    if f.monitor.shape[1]:
+        u = np.asarray(f.monitor[:, 0, :], dtype=float)
+        uh = np.linalg.norm(u[:, :2], axis=1)
+        row["max_disp_m"] = float(uh.max())
+        row["residual_disp_m"] = float(u[-1, 0])
+    row["e_a_mean"] = float(s["e_a_mean"]) if "e_a_mean" in s else None
+    row["bounce_max_m_s"] = float(s["bounce_max_m_s"]) if "bounce_max_m_s" in s else None
+    row["failed_shear_fraction"] = f.failed_shear / npts
+    row["failed_tension_fraction"] = f.failed_tension / npts
+    row["steps"] = int(a["steps"])
+    row["dt"] = float(a["dt"])
+    row["dt_min"] = float(a["dt_min"])
+    row["runtime_s"] = float(a["runtime_s"])
+    row["kernel_s"] = float(a.get("kernel_s", a["runtime_s"]))
+    if a.get("beta_mode"):  # an automatic beta: the value chosen and how (rockdem.beta_choice)
+        row["beta_s"] = float(a["beta"])
+        row["beta_pairs"] = str(a["beta_pairs"])
+        for key in ("beta_target_value", "beta_achieved_e_a", "beta_iterations", "beta_search_time_s"):
+            if key in a:
+                row[key] = float(a[key])
+    if spec.history:
+        row["history"] = _history(spec, t, theta, f.monitor, a)
+    return row
+
+
+def _history(spec: Any, t: np.ndarray, theta: np.ndarray, monitor: np.ndarray, attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """Decimated history (time, rotation, first monitor's x displacement). A run stopped at rest
+    is continued at rest to its duration (same interval), so that it compares with full runs."""
+    step = 1
+    if spec.history_interval and len(t) > 1:
+        step = max(1, int(round(spec.history_interval / (t[1] - t[0]))))
+    tt, rot = t[::step], theta[::step]
+    disp = monitor[::step, 0, 0].astype(float) if monitor.shape[1] else None
+    if attrs.get("stop_reason") == "rest" and len(t) > 1:
+        h = step * float(attrs["record_interval"])
+        n = int(np.floor((float(attrs["duration"]) - tt[-1]) / h + 1e-9))
+        if n > 0:
+            tt = np.concatenate([tt, tt[-1] + h * np.arange(1, n + 1)])
+            rot = np.concatenate([rot, np.full(n, theta[-1])])
+            if disp is not None:
+                disp = np.concatenate([disp, np.full(n, float(monitor[-1, 0, 0]))])
+    hist: dict[str, Any] = {"time": tt.tolist(), "rotation": rot.tolist()}
+    if disp is not None:
+        hist["displacement"] = disp.tolist()
+    return hist
+
+
+def case_of(data: Mapping[str, Any]) -> Case:
+    """The case of a case dict, through this process's template cache (see the module notes)."""
+    key = template_key(data)
+    with _LOCK:
+        tpl = _TEMPLATES.get(key)
+        if tpl is not None:
+            _TEMPLATES.move_to_end(key)
+    if tpl is not None:
+        return tpl.derive(data)
+    tpl = CaseTemplate(data)
+    with _LOCK:
+        _TEMPLATES[key] = tpl
+        while len(_TEMPLATES) > TEMPLATE_CACHE:
+            _TEMPLATES.popitem(last=False)
+    return tpl.case
+
+
+_STARTS: OrderedDict[str, Any] = OrderedDict()
+
+
+def _start(data: Mapping[str, Any], case: Case) -> Any:
+    """The run's :class:`rockdem.simulation.Start` (a copy), kept per specimen, damping (with the
+    per-pair betas of an automatic beta) and timestep options: a derived case's model differs from
+    its template's in the inputs only."""
+    from .simulation import prepare_start
+
+    r = case.run
+    key = json.dumps([template_key(data), case.model.damping.__dict__, case.model.arrays.mat_beta.tolist(), r.timestep_rule,
+                      r.safety, r.resolution, r.dt], sort_keys=True, default=str)
+    with _LOCK:
+        start = _STARTS.get(key)
+        if start is not None:
+            _STARTS.move_to_end(key)
+    if start is None:
+        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution, dt=r.dt)
+        with _LOCK:
+            _STARTS[key] = start
+            while len(_STARTS) > TEMPLATE_CACHE:
+                _STARTS.popitem(last=False)
+    return start.copy()
+
+
+def batch_row(spec: Any) -> dict[str, Any]:
+    """The summary row of one spec by the batch path (raises as :func:`rockdem.studies.run_spec`)."""
+    from .run_cli import run_options
+    from .simulation import run_model
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    data = spec.case_dict()
+    case = case_of(data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = run_model(case.model, **run_options(case), progress=False, start=_start(data, case))
+    row = summary_row(spec, data, frames_from_run(case, out))
+    row["wall_s"] = time.perf_counter() - t0
+    row["cpu_s"] = time.process_time() - c0
+    return row
+
+
+def run_batch(specs: Sequence[Any]) -> list[dict[str, Any]]:
+    """Summary rows of many specs in this process (a task of a study): one row per spec, an error
+    row (status "error") instead of an exception."""
+    return [_safe(batch_row, s) for s in specs]
+
+
+def _safe(fn: Any, spec: Any) -> dict[str, Any]:
+    try:
+        return fn(spec)
+    except Exception as exc:  # noqa: BLE001 - a failed run is recorded, not fatal
+        return {"id": spec.id, **spec.inputs, "status": "error", "error": f"{type(exc).__name__}: {exc}"}

@@ -1,0 +1,235 @@
+"""Checkpoints (rockdem.checkpoint): a continued run is bit-identical to an uninterrupted one,
+also after a stop signal mid-run; a checkpoint refuses another model; a settled state starts new
+loadings at t = 0."""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import rockdem.simulation as simulation
+from rockdem.case import apply_overrides, example_case, parse_case
+from rockdem.checkpoint import Checkpoint, model_hash, structure_hash
+from rockdem.cli import main
+from rockdem.kernels.layout import State
+from rockdem.model import Damping
+from rockdem.results import load
+from rockdem.simulation import simulate
+
+RUN = {"record_interval": 0.01, "contact_interval": 0.05, "progress": False}
+
+
+@pytest.fixture(scope="module")
+def case():
+    """The built-in free-rocking block (a 0.2 x 2 m block released from 90 % of its instability angle)."""
+    return parse_case(example_case("free-rocking"))
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(case):
+    return simulate(case.model, 0.8, monitors=case.monitors, **RUN)
+
+
+def assert_identical(a: xr.Dataset, b: xr.Dataset) -> None:
+    """Every variable and coordinate of two results equal bit for bit (NaN where NaN)."""
+    assert set(a.variables) == set(b.variables)
+    for name in a.variables:
+        x, y = a[name].values, b[name].values
+        assert x.shape == y.shape, name
+        assert np.array_equal(x, y, equal_nan=x.dtype.kind == "f"), f"{name} differs"
+
+
+def test_continued_run_is_bit_identical_to_an_uninterrupted_one(case, uninterrupted, tmp_path):
+    first = simulate(case.model, 0.4, monitors=case.monitors, checkpoint=tmp_path / "half.npz", **RUN)
+    assert first.attrs["checkpoint"] == str(tmp_path / "half.npz")
+    ck = Checkpoint.load(tmp_path / "half.npz")
+    assert ck.frame == first.sizes["time"] == 41 and 0.4 <= ck.time < 0.4 + ck.timestep.dt
+    cont = simulate(case.model, 0.8, monitors=case.monitors, initial=tmp_path / "half.npz", progress=False)
+    assert cont.attrs["continued_from_time"] == ck.time
+    assert cont.sizes["time"] == 81 and cont.sizes["contact_time"] == 17
+    assert_identical(uninterrupted, cont)
+    assert cont.attrs["steps"] == uninterrupted.attrs["steps"]
+
+
+def test_a_stop_signal_mid_run_writes_a_checkpoint_that_continues_exactly(case, uninterrupted, tmp_path, monkeypatch):
+    # SIGINT arrives while the compiled chunk runs (sent from inside it); the run must stop at a chunk
+    # boundary with its state, frame counter and snapshots consistent, and save them. Chunks end at
+    # the contact snapshots (every 0.05 s), so the third ends near 0.15 s.
+    real, calls = simulation.advance, []
+
+    def advance_then_signal(*args):
+        out = real(*args)
+        calls.append(1)
+        if len(calls) == 3:
+            os.kill(os.getpid(), signal.SIGINT)
+        return out
+
+    monkeypatch.setattr(simulation, "advance", advance_then_signal)
+    part = simulate(case.model, 0.8, monitors=case.monitors, checkpoint=tmp_path / "stop.npz", **RUN)
+    monkeypatch.undo()
+    assert part.attrs["interrupted"] == 1
+    ck = Checkpoint.load(tmp_path / "stop.npz")
+    assert 0.0 < ck.time < 0.8 and ck.frame == part.sizes["time"] < 81
+    cont = simulate(case.model, 0.8, monitors=case.monitors, initial=ck, progress=False)
+    assert_identical(uninterrupted, cont)
+
+
+def test_periodic_checkpoints_are_written_during_the_run(case, tmp_path, monkeypatch):
+    saved = []
+    real = Checkpoint.save
+    monkeypatch.setattr(Checkpoint, "save", lambda self, path: saved.append(self.time) or real(self, path))
+    simulate(case.model, 0.3, checkpoint=tmp_path / "p.npz", checkpoint_every=1e-9, **RUN)
+    assert len(saved) >= 2 and saved == sorted(saved)  # during the run, then at the end
+    assert saved[-1] >= 0.3
+
+
+def test_checkpoint_refuses_another_model_or_other_options(case, tmp_path):
+    simulate(case.model, 0.1, checkpoint=tmp_path / "c.npz", **RUN)
+    damped = parse_case(apply_overrides(example_case("free-rocking"), ["damping.beta=0.001"])).model
+    assert structure_hash(damped) == structure_hash(case.model) and model_hash(damped) != model_hash(case.model)
+    with pytest.raises(ValueError, match="another model.*reset_clock"):
+        simulate(damped, 0.2, initial=tmp_path / "c.npz", progress=False)
+    taller = parse_case(apply_overrides(example_case("free-rocking"), ["specimen.height=2.5"])).model
+    with pytest.raises(ValueError, match="another model"):
+        simulate(taller, 0.2, initial=tmp_path / "c.npz", progress=False)
+    with pytest.raises(ValueError, match="blocks, geometry or joint"):
+        simulate(taller, 0.2, initial=Checkpoint.load(tmp_path / "c.npz").reset_clock(), progress=False)
+    with pytest.raises(ValueError, match="record_interval = 0.02 differs"):
+        simulate(case.model, 0.2, initial=tmp_path / "c.npz", record_interval=0.02, progress=False)
+    with pytest.raises(ValueError, match="already at t"):
+        simulate(case.model, 0.05, initial=tmp_path / "c.npz", progress=False)
+
+
+def test_checkpoint_of_another_engine_layout_is_refused_by_name(case, tmp_path):
+    simulate(case.model, 0.05, checkpoint=tmp_path / "c.npz", **RUN)
+    with np.load(tmp_path / "c.npz") as z:
+        arrays = {k: z[k] for k in z.files if k != f"state/{State._fields[-1]}"}
+    np.savez(tmp_path / "old.npz", **arrays)
+    with pytest.raises(ValueError, match=f"engine State differs.*missing \\['{State._fields[-1]}'\\]"):
+        Checkpoint.load(tmp_path / "old.npz")
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="not a rockdem checkpoint"):
+        Checkpoint.load(tmp_path / "junk.npz")
+
+
+def test_settled_state_starts_new_loadings_at_rest(tmp_path):
+    # A block settled under gravity: its contacts carry its weight. Started again at t = 0 from
+    # that state, under gravity, it stays at rest (no settling transient); under another damping
+    # (a new loading on the same blocks) the run starts from the same poses and contact forces.
+    data = {**example_case("free-rocking"), "loading": {"type": "gravity"}}
+    model = parse_case(data).model
+    raw = simulate(model, 0.3, checkpoint=tmp_path / "settled.npz", **RUN)
+    settled = Checkpoint.load(tmp_path / "settled.npz").reset_clock()
+    assert settled.time == 0.0 and settled.frame == 0
+    again = simulate(model, 0.1, initial=settled, **RUN)
+    assert again.time.values[0] == 0.0
+    np.testing.assert_array_equal(again.block_position.values[0], settled.state.position)
+    weight = float(model.arrays.block_mass[1]) * 9.81
+    assert np.nansum(again.point_normal_force.values[0]) == pytest.approx(weight, rel=1e-3)
+    # at rest: far below the kinetic energy of the first run's settling transient
+    assert again.energy_kinetic.max() < 1e-3 * raw.energy_kinetic.max()
+    damped = parse_case(apply_overrides(data, ["damping.beta=0.001"])).model
+    other = simulate(damped, 0.1, initial=settled, **RUN)
+    np.testing.assert_array_equal(other.block_position.values[0], settled.state.position)
+
+
+def test_cli_run_from_checkpoint_equals_one_run(tmp_path):
+    args = ["run", "--example", "free-rocking", "--quiet", "--no-plot", "--set", "run.record_interval=0.01"]
+    assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "one")]) == 0
+    assert main(args + ["--duration", "0.2", "--out", str(tmp_path / "two")]) == 0
+    ck = tmp_path / "two" / "checkpoint.npz"
+    assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "two"), "--from", str(ck)]) == 0
+    assert_identical(load(tmp_path / "one" / "result.nc"), load(tmp_path / "two" / "result.nc"))
+    assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "three"), "--from", str(ck), "--settled", str(ck)]) == 2
+    assert main(args + ["--set", "damping.beta=0.002", "--out", str(tmp_path / "four"), "--from", str(ck)]) == 2
+
+
+def test_settled_state_starts_an_earthquake_case(tmp_path):
+    # settle the El Centro example's block under gravity alone, then run the earthquake case from it
+    from pathlib import Path
+
+    from rockdem.case import load_case
+
+    quake = load_case(Path(__file__).resolve().parents[1] / "examples" / "elcentro_block_foundation.toml")
+    gravity = parse_case({**quake, "loading": {"type": "gravity"}}).model
+    model = parse_case(quake).model
+    assert structure_hash(gravity) == structure_hash(model) and model_hash(gravity) != model_hash(model)
+    simulate(gravity, 0.2, checkpoint=tmp_path / "s.npz", **RUN)
+    start = Checkpoint.load(tmp_path / "s.npz").reset_clock()
+    ds = simulate(model, 0.3, initial=start, **RUN)
+    np.testing.assert_array_equal(ds.block_position.values[0], start.state.position)
+    assert ds.attrs["steps"] > 0 and ds.time.values[0] == 0.0
+
+
+# --- checkpoints of runs with a stop rule (rockdem.stopping) ---------------------------------------
+# The paper's Fig. 6A block (0.19 x 0.5 m) released from 90 % of eta, MP damped (alpha = 8): it comes
+# to rest at about 2.5 s, so stop="rest" decides it there; snapshots every 0.05 s cut chunks as well.
+STOP_RUN = {"record_interval": 0.005, "contact_interval": 0.05, "progress": False}
+
+
+@pytest.fixture(scope="module")
+def resting():
+    over = {"run.record_interval": 0.005, "specimen.height": 0.5, "specimen.width": 0.19, "damping.beta": 0.0,
+            "damping.alpha": 8.0}
+    return parse_case(apply_overrides(example_case("free-rocking"), [f"{k}={v}" for k, v in over.items()])).model
+
+
+@pytest.fixture(scope="module")
+def stopped(resting):
+    """The uninterrupted run with stop="rest" (to 4 s) and without a stop rule."""
+    return simulate(resting, 4.0, stop="rest", **STOP_RUN), simulate(resting, 4.0, **STOP_RUN)
+
+
+def test_continued_run_with_a_stop_rule_is_bit_identical(resting, stopped, tmp_path):
+    # cut at 1.02 s, before the decision and between two contact snapshots (which end chunks too):
+    # the continuation with the same rule gives the decision, the frames, the snapshots and the steps
+    # past the decision of the uninterrupted run (a chunk cut short by the end of a run: see
+    # test_stop_decided_in_the_chunk_cut_by_the_end_of_a_run)
+    one, _ = stopped
+    assert one.attrs["stop_reason"] == "rest" and 1.5 < one.attrs["stop_time"] < 3.5
+    first = simulate(resting, 1.02, stop="rest", checkpoint=tmp_path / "a.npz", **STOP_RUN)
+    assert "stop_reason" not in first.attrs
+    ck = Checkpoint.load(tmp_path / "a.npz")
+    assert ck.check_target is not None and ck.check_target > ck.time
+    cont = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, cont)
+    for key in ("steps", "dt_min", "stop_reason", "stop_time", "stop_block"):
+        assert cont.attrs[key] == one.attrs[key], key
+
+
+def test_checkpoint_of_a_stopped_run_continues_as_decided_or_runs_on(resting, stopped, tmp_path):
+    one, full = stopped
+    again = simulate(resting, 4.0, stop="rest", checkpoint=tmp_path / "s.npz", **STOP_RUN)
+    ck = Checkpoint.load(tmp_path / "s.npz")
+    # the checkpoint holds the state where the loop ended and every frame computed up to there
+    assert ck.frame >= again.sizes["time"] and ck.time > again.attrs["stop_time"]
+    assert int(ck.state.step[0]) == again.attrs["steps"]
+    # the same rule: decided from the saved frames, nothing stepped
+    same = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, same)
+    assert same.attrs["steps"] == one.attrs["steps"] and same.attrs["stop_time"] == one.attrs["stop_time"]
+    # without a stop rule it runs on to the end: the uninterrupted run without one
+    on = simulate(resting, 4.0, initial=ck, progress=False)
+    assert "stop_reason" not in on.attrs and on.attrs["stop_rule"] == "off"
+    assert_identical(full, on)
+    assert on.attrs["steps"] == full.attrs["steps"]
+
+
+def test_stop_decided_in_the_chunk_cut_by_the_end_of_a_run(resting, tmp_path):
+    # the first run ends 1 ms after the decided frame, inside the chunk of check_steps steps where the
+    # uninterrupted run decided it (no snapshots here to cut that chunk): it stops at its own end;
+    # continued, it computes the rest of that chunk first, so that its state (the steps past the
+    # decision) is the uninterrupted run's
+    run = {**STOP_RUN, "contact_interval": None}
+    one = simulate(resting, 4.0, stop="rest", **run)
+    short = simulate(resting, one.attrs["stop_time"] + 0.001, stop="rest", checkpoint=tmp_path / "c.npz", **run)
+    assert short.attrs["stop_time"] == one.attrs["stop_time"] and short.attrs["steps"] < one.attrs["steps"]
+    ck = Checkpoint.load(tmp_path / "c.npz")
+    assert ck.check_target is not None
+    cont = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
+    assert_identical(one, cont)
+    assert cont.attrs["steps"] == one.attrs["steps"]

@@ -1,0 +1,114 @@
+"""Contact output: the case/CLI option, force vectors checked by statics, the per-contact table,
+ParaView glyph arrays, export defaults, and the documented rule for the recorded frame times."""
+
+from __future__ import annotations
+
+import meshio
+import numpy as np
+import pandas as pd
+import pytest
+
+from rockdem.case import apply_overrides, example_case, parse_case
+from rockdem.cli import main
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, ModelBuilder
+from rockdem.results import contact_table, load, save, write_contact_table
+from rockdem.simulation import simulate
+from rockdem.vtk_export import DEFAULT_MAX_FILES, default_every, export_vtk
+from viz_cases import example_result
+
+MASS = 2000 * 0.3 * 0.4 * 0.5  # [kg]
+PUSH = 2.0  # horizontal body acceleration [m/s^2], below friction (tan 40 deg g = 8.2 m/s^2)
+
+
+@pytest.fixture(scope="module")
+def pushed():
+    """A block at rest on a fixed base under gravity and a steady horizontal body acceleration."""
+    bld = ModelBuilder()
+    bld.default_material = JointMaterial(kn=1e9, friction_angle=40)
+    bld.add_box(1, 1, 0.2, base_center=(0, 0, -0.2), driven=True, name="ground", group="ground")
+    bld.add_box(0.3, 0.4, 0.5, density=2000, name="block")
+    bld.set_body_acceleration([0.0, 10.0], [[PUSH, 0, 0], [PUSH, 0, 0]])
+    model = bld.finalize(damping=Damping(beta=2e-3))
+    return simulate(model, 0.4, record_interval=0.05, contact_interval=0.1, progress=False)
+
+
+def test_contact_force_vectors_balance_the_loads_on_a_block_at_rest(pushed):
+    # Statics: the contact forces on the block balance its weight m g (normal) and the body load
+    # m a (shear): sum F_n = (0, 0, m g), sum F_s = (-m a, 0, 0); the base normal is +z.
+    tab = contact_table(pushed)
+    last = tab[tab.time == tab.time.max()]
+    assert set(last.block) == {"block"} and set(last.partner) == {"ground"} and len(last) == 4
+    np.testing.assert_allclose(last[["nx", "ny", "nz"]].to_numpy(), np.tile([0, 0, 1.0], (4, 1)), atol=1e-9)
+    fn = last[["fnx", "fny", "fnz"]].to_numpy().sum(axis=0)
+    fs = last[["fsx", "fsy", "fsz"]].to_numpy().sum(axis=0)
+    np.testing.assert_allclose(fn, [0, 0, MASS * 9.81], rtol=1e-3, atol=1e-6 * MASS * 9.81)
+    np.testing.assert_allclose(fs, [-MASS * PUSH, 0, 0], rtol=2e-3, atol=1e-3 * MASS * PUSH)
+    np.testing.assert_allclose(np.linalg.norm(last[["fsx", "fsy", "fsz"]], axis=1), last.shear_force, rtol=1e-12)
+
+
+def test_vtk_contacts_carry_glyph_vectors(pushed, tmp_path):
+    export_vtk(pushed, tmp_path)
+    k = pushed.sizes["contact_time"] - 1
+    mesh = meshio.read(tmp_path / f"contacts_{k:06d}.vtu")
+    has = pushed.point_partner.values[k] >= 0
+    n, fn = pushed.point_normal.values[k][has], pushed.point_normal_force.values[k][has]
+    np.testing.assert_allclose(mesh.point_data["normal"], n)
+    np.testing.assert_allclose(mesh.point_data["normal_force_vector"], fn[:, None] * n)
+    np.testing.assert_allclose(mesh.point_data["shear_force_vector"], pushed.point_shear_force_vector.values[k][has])
+
+
+def test_contact_table_formats_and_its_error(pushed, tmp_path):
+    p = write_contact_table(pushed, tmp_path / "c.csv")
+    back = pd.read_csv(p)
+    np.testing.assert_allclose(back.normal_force, contact_table(pushed).normal_force)
+    auto = write_contact_table(pushed, tmp_path / "contacts")
+    assert auto.suffix in (".csv", ".parquet")
+    with pytest.raises(ValueError, match="contact_interval"):
+        contact_table(simulate_no_contacts())
+
+
+def simulate_no_contacts():
+    case = parse_case(apply_overrides(example_case("free-rocking"), ["run.duration=0.02"]))
+    return simulate(case.model, 0.02, progress=False)
+
+
+def test_case_and_cli_option_contact_interval(tmp_path, capsys):
+    out = tmp_path / "run"
+    args = ["run", "--example", "free-rocking", "--duration", "0.3", "--quiet", "--no-plot", "--no-checkpoint",
+            "--out", str(out), "--set", "run.contact_interval=0.1"]
+    assert main(args) == 0
+    ds = load(out / "result.nc")
+    assert ds.sizes["contact_time"] == 4
+    table = list(out.glob("contacts.*"))
+    assert len(table) == 1
+    assert main(["export", str(out / "result.nc"), "--vtk", str(tmp_path / "vtk")]) == 0
+    assert len(list((tmp_path / "vtk").glob("contacts_*.vtu"))) == 4
+    assert main(["export", str(out / "result.nc"), "--contacts", str(tmp_path / "t.csv")]) == 0
+    assert len(pd.read_csv(tmp_path / "t.csv")) == int((ds.point_partner.values >= 0).sum())
+    with pytest.raises(ValueError, match=r"\[run\] contact_interval must be positive"):
+        parse_case(apply_overrides(example_case("free-rocking"), ["run.contact_interval=0"]))
+
+
+def test_export_writes_at_most_the_default_number_of_frames(tmp_path, capsys):
+    assert default_every(5001) == 10 and default_every(501) == 1 and default_every(502) == 2
+    assert len(range(0, 5001, default_every(5001))) <= DEFAULT_MAX_FILES
+    ds = example_result()  # 201 frames: all written
+    path = save(ds, tmp_path / "r.nc")
+    assert main(["export", str(path), "--vtk", str(tmp_path / "v")]) == 0
+    assert len(list((tmp_path / "v").glob("blocks_*.vtu"))) == ds.sizes["time"]
+    assert main(["export", str(path), "--vtk", str(tmp_path / "w"), "--every", "50"]) == 0
+    assert len(list((tmp_path / "w").glob("blocks_*.vtu"))) == 5
+    assert "every 50th" in capsys.readouterr().out
+
+
+def test_frames_are_recorded_at_the_step_nearest_each_multiple_of_the_interval():
+    # The documented rule (simulate's record_interval): frame k at the first step with
+    # t >= k dt_rec - dt/2, so |t_k - k dt_rec| <= dt/2 with dt the step then taken (at most the
+    # initial dt, as the step is only lowered); the time coordinate is the exact engine time.
+    ds = example_result()
+    t = ds.time.values
+    k = np.arange(t.size)
+    dt0 = ds.attrs["dt"]
+    assert np.max(np.abs(t - k * 0.01)) <= 0.5 * dt0 + 1e-12
+    assert np.all(np.abs(np.diff(t) - 0.01) <= dt0 + 1e-12)  # spacing: the interval within one step
