@@ -5,7 +5,8 @@ fast): ``ModelBuilder``, ``Damping``, ``Motion``, ``JointMaterial``, ``box``, ``
 ``simulate``, ``save``, ``load``, the specimen builders (``stacked_blocks``, ``brick_wall``,
 ``parapet``, ``facade``, ``two_block_wall``), loading (``apply_earthquake``, ``pushover``,
 ``apply_rod_pushover``, ``capacity_curve``, ``read_record``), ``advise``, ``summarize_result``,
-``housner_rock``, case files (``load_case``, ``parse_case``, ``run_case``) and studies
+``housner_rock``, automatic SP damping (``critical_betas``, ``RestitutionTarget``; ``Damping(beta="auto")``
+and ``Damping(beta="critical")``), case files (``load_case``, ``parse_case``, ``run_case``) and studies
 (``RunSpec``, ``execute``, ``calibrate``, ``run_ida``).
 """
 
@@ -25,6 +26,7 @@ _API = {
     "apply_earthquake": "loading", "pushover": "loading", "apply_rod_pushover": "loading",
     "capacity_curve": "loading", "read_record": "records",
     "advise": "advisor", "summarize_result": "analysis",
+    "critical_betas": "interfaces", "RestitutionTarget": "beta_choice",
     "load_case": "case", "parse_case": "case", "run_case": "run_cli",
     "RunSpec": "studies", "execute": "studies", "calibrate": "calibration", "run_ida": "fragility",
 }

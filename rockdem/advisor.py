@@ -15,7 +15,11 @@ B (rocking direction), height H and length L:
 * eta = atan(B/H), semi-diagonal R, eta/R with a bouncing warning above 45 deg/m (§3.1);
 * Housner e_eta = 1 - 1.5 sin^2 eta and 0.95 e_eta (§3.2.1);
 * stable timesteps for MP and SP runs and the expected SP/MP cost ratio (central differences,
-  with Belytschko's reduction for SP damping); only these depend on the length L.
+  with Belytschko's reduction for SP damping); only these depend on the length L;
+* on request, the beta of the model itself (a block, a stack or a one-sided façade with these
+  inputs, built with :mod:`rockdem.specimens`): targeted to a restitution (``target_restitution``:
+  short free-rocking runs, :mod:`rockdem.targeting`) and/or per joint group pair from each pair's
+  own critical impact (``per_interface``: beta = 2 zeta / sqrt(kn A / m), :mod:`rockdem.interfaces`).
 
 Geometry of the rocking body: the whole element B x H for ``single`` and ``one-sided``; one block
 B x (H / blocks) for ``stacked`` (each block of the stack rocks and impacts its neighbours). More
@@ -31,18 +35,28 @@ import json
 import math
 import warnings
 from dataclasses import asdict, dataclass, field, fields
-from typing import Any, Iterator
+from typing import TYPE_CHECKING, Any, Iterator
 
 import numpy as np
 
+from .beta_choice import BetaChoice, RestitutionTarget
 from .kernels.contact import sp_critical_factor
 
-__all__ = ["Configuration", "AdviceInput", "Advice", "advise", "impact_frequencies", "omega_max_bound", "register_cli"]
+if TYPE_CHECKING:
+    from .model import ModelBuilder
+
+__all__ = [
+    "Configuration", "AdviceInput", "Advice", "advise", "impact_frequencies", "omega_max_bound", "model_builder",
+    "model_beta", "register_cli",
+]
 
 BOUNCING_LIMIT_DEG_PER_M = 45.0
 """eta/R above which bouncing was critical with under-damped impacts [deg/m] (§3.1, Fig. 5B)."""
 SAFETY = 0.9
 """Fraction of the stable step used by the engine."""
+PROBE_FRICTION_DEG = 80.0
+"""Friction angle of the model the advisor simulates for its targeted beta [deg]: no sliding, so
+the probe measures the rocking impacts alone (the paper's Table 2 block: mu > 5)."""
 
 
 class Configuration(str, enum.Enum):
@@ -70,6 +84,14 @@ class AdviceInput:
             blocks > 1, else single (``configuration_implied`` is then True).
         damping_ratio: target zeta at the critical frequency [-] (1 = critical).
         points: interface points across the thickness (2 = the corners) [-].
+        target_restitution: None, or the restitution the model's own impacts should give
+            (``"eta"``, ``"0.95eta"`` or a number): the advisor then simulates the model and finds
+            its beta (``Damping(beta="auto")``).
+        per_interface: give every joint group pair of the model its own critical beta
+            (``Damping(beta="critical")``, or with ``target_restitution`` the targeted beta on the
+            rocking interface and the critical one elsewhere).
+        release_fraction: release of the targeted search's probe as a fraction of eta [-]
+            (default :data:`rockdem.targeting.DEFAULT_RELEASE_FRACTION`).
     """
 
     width: float
@@ -82,6 +104,9 @@ class AdviceInput:
     configuration: Configuration | str | None = None
     damping_ratio: float = 1.0
     points: int = 2
+    target_restitution: str | float | None = None
+    per_interface: bool = False
+    release_fraction: float | None = None
     configuration_implied: bool = field(default=False, init=False)
 
     def __post_init__(self) -> None:
@@ -106,6 +131,15 @@ class AdviceInput:
         object.__setattr__(self, "configuration", conf)
         if conf is Configuration.STACKED and self.blocks < 2:
             raise ValueError("configuration 'stacked' needs blocks >= 2 (height is the total height, each block height/blocks)")
+        if self.target_restitution is not None:
+            RestitutionTarget.parse(self.target_restitution)
+        if not isinstance(self.per_interface, bool):
+            raise ValueError(f"per_interface must be True or False, got {self.per_interface!r}")
+        if self.release_fraction is not None and not (
+            isinstance(self.release_fraction, (int, float)) and not isinstance(self.release_fraction, bool)
+            and 0.0 < self.release_fraction < 1.0
+        ):
+            raise ValueError(f"release_fraction must lie in (0, 1) (a fraction of eta), got {self.release_fraction!r}")
         if self.youngs_modulus < 1e6:
             raise ValueError(
                 f"youngs_modulus = {self.youngs_modulus!r} Pa is below 1 MPa: E is in Pa "
@@ -151,6 +185,9 @@ class Advice:
     bouncing_expected: bool = False
     recommendations: tuple[str, ...] = ()
     warnings: tuple[str, ...] = ()
+    beta_choice: BetaChoice | None = None
+    recommended_beta: float = math.nan
+    recommended_why: str = ""
 
     def rows(self) -> Iterator[tuple[str, float, str, str]]:
         """(label, value, unit, source) for every numeric output, in table order."""
@@ -167,13 +204,25 @@ class Advice:
             for f in fields(self)
             if "unit" in f.metadata
         }
-        return {
+        out: dict[str, Any] = {
             "inputs": inputs,
             "outputs": outputs,
+            "recommended_beta": {"value": self.recommended_beta, "unit": "s", "why": self.recommended_why},
             "bouncing_expected": self.bouncing_expected,
             "recommendations": list(self.recommendations),
             "warnings": list(self.warnings),
         }
+        c = self.beta_choice
+        if c is not None:
+            out["model_beta"] = {
+                "mode": c.mode, "beta_s": c.beta, "per_interface": c.per_interface or c.mode == "critical",
+                "target": c.target, "target_value": _number(c.target_value), "achieved_e_a": _number(c.achieved),
+                "probe_runs": c.iterations, "search_time_s": c.search_time, "release_fraction": _number(c.release_fraction),
+                "pairs": [{"pair": p.label, "beta_s": p.beta, "source": p.source, "omega_rad_s": _number(p.omega),
+                           "zeta": _number(p.zeta), "how": p.how} for p in c.pairs],
+                "explanation": c.lines(),
+            }
+        return out
 
     def table(self) -> str:
         """Readable text table with units and sources, then recommendations and warnings."""
@@ -188,10 +237,19 @@ class Advice:
         w = max(len(r[0]) for r in rows)
         for label, value, unit, source in rows:
             lines.append(f"  {label:<{w}}  {value:>12.5g}  {unit:<6}  {source}")
+        if self.beta_choice is not None:
+            lines += ["", "Beta of the model itself (simulated with rockdem; block(s) built from these inputs):"]
+            lines += [f"  {line}" for line in self.beta_choice.lines()]
+        lines += ["", f"Recommended beta: {self.recommended_beta:.4g} s. {self.recommended_why}"]
         lines += ["", "Recommendations:"] + [f"  - {r}" for r in self.recommendations]
         if self.warnings:
             lines += ["", "Warnings:"] + [f"  ! {r}" for r in self.warnings]
         return "\n".join(lines)
+
+
+def _number(v: float) -> float | None:
+    """A float for JSON, None for nan (strict JSON has no NaN)."""
+    return float(v) if math.isfinite(v) else None
 
 
 def _configuration_text(i: AdviceInput) -> str:
@@ -317,7 +375,9 @@ def advise(inputs: AdviceInput | None = None, **kwargs: Any) -> Advice:
     dt3 = 0.2 * math.sqrt(m_min / k_max)
     dt3_sp = dt3 * sp_critical_factor(beta, w3)
     bouncing = eta_r > BOUNCING_LIMIT_DEG_PER_M
-    recs = _recommendations(i, beta, alpha_mp, kn, eta_r, bouncing, dt_mp / dt_sp)
+    choice = model_beta(i) if (i.target_restitution is not None or i.per_interface) else None
+    rec_beta, why = _recommended(i, beta, choice)
+    recs = _recommendations(i, rec_beta, alpha_mp, kn, eta_r, bouncing, dt_mp / dt_sp)
     for msg in warn:
         warnings.warn(msg, stacklevel=2)
     return Advice(
@@ -351,6 +411,76 @@ def advise(inputs: AdviceInput | None = None, **kwargs: Any) -> Advice:
         bouncing_expected=bouncing,
         recommendations=tuple(recs),
         warnings=tuple(warn),
+        beta_choice=choice,
+        recommended_beta=rec_beta,
+        recommended_why=why,
+    )
+
+
+def model_builder(i: AdviceInput) -> "ModelBuilder":
+    """The model the inputs describe, on a fixed foundation (for :func:`model_beta`).
+
+    single: one B x L x H block (with n_b > 1, its kn = E / (H / n_b): a discretised element that
+    rocks as a whole); stacked: n_b blocks of H / n_b (:func:`rockdem.specimens.stacked_blocks`);
+    one-sided: a façade with return walls 4 mm behind it (:func:`rockdem.specimens.facade`).
+    Joints: kn = E / (H / n_b), ks = kn / (2 (1 + nu)), friction :data:`PROBE_FRICTION_DEG`;
+    ``points`` x 2 interface points per face.
+    """
+    from .materials import JointMaterial, ks_from_kn
+    from .model import ModelBuilder
+    from .specimens import facade, stacked_blocks
+
+    kn = i.youngs_modulus / (i.height / i.blocks)
+    mat = JointMaterial(kn=kn, ks=ks_from_kn(kn, i.poisson), friction_angle=PROBE_FRICTION_DEG)
+    b = ModelBuilder(points=(i.points, 2))
+    b.default_material = mat
+    if i.configuration is Configuration.ONE_SIDED:
+        facade(b, width=i.width, height=i.height, length=i.length, density=i.density, material=mat)
+    else:
+        n = i.blocks if i.configuration is Configuration.STACKED else 1
+        stacked_blocks(b, width=i.width, length=i.length, heights=[i.height / n] * n, density=i.density, material=mat)
+    return b
+
+
+def model_beta(i: AdviceInput) -> BetaChoice:
+    """beta of the model the inputs describe (:func:`model_builder`): targeted to
+    ``i.target_restitution`` (``Damping(beta="auto")``) and/or per group pair (``per_interface``)."""
+    from .model import Damping
+
+    if i.target_restitution is not None:
+        damping = Damping(beta="auto", target_restitution=i.target_restitution, per_interface=i.per_interface,
+                          damping_ratio=i.damping_ratio, release_fraction=i.release_fraction)
+    else:
+        damping = Damping(beta="critical", damping_ratio=i.damping_ratio)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = model_builder(i).finalize(damping=damping)
+    assert model.beta_choice is not None
+    return model.beta_choice
+
+
+def _recommended(i: AdviceInput, beta_rule: float, choice: BetaChoice | None) -> tuple[float, str]:
+    """The beta the advisor would use [s] and why."""
+    if choice is not None and choice.mode == "auto":
+        return choice.beta, (
+            f"Targeted: with it the model's own free-rocking impacts give a mean apparent restitution "
+            f"e_a (Eq. 6) of {choice.achieved:.4f} against the target {choice.target} = {choice.target_value:.4f} "
+            f"({choice.iterations} short runs); use damping.beta = \"auto\" with target_restitution = "
+            f"\"{choice.target}\" in a case to repeat it on the exact model."
+        )
+    if choice is not None:
+        per = "; ".join(f"{p.label} {p.beta:.4g} s" for p in choice.pairs if p.source == "critical")
+        return choice.beta, (
+            f"Per interface (damping.beta = \"critical\"): each joint group pair beta = 2 zeta / omega of its own "
+            f"critical impact, omega = sqrt(kn A / m) with the model's springs (Eq. 1-4): {per}; the number is the "
+            "largest of them."
+        )
+    rule = "x sqrt 2 (stacked, §2.2)" if i.configuration is Configuration.STACKED else (
+        "B and h swapped x sqrt 2 (one-sided, §2.2)" if i.configuration is Configuration.ONE_SIDED else "(§2.2)")
+    return beta_rule, (
+        f"DeJong's rule as in the paper: beta = 2 zeta / omega_crit, omega_crit = omega_e of Eq. 3 {rule}. It does not "
+        "depend on the interface points and over-damped the §4.1 parapet; give --target-restitution (e.g. 0.95eta) "
+        "for the beta whose impacts give a chosen restitution, or --per-interface for each pair's own critical beta."
     )
 
 
@@ -420,6 +550,9 @@ def _run(args: argparse.Namespace) -> int:
         configuration=args.configuration,
         damping_ratio=args.damping_ratio,
         points=args.points,
+        target_restitution=args.target_restitution,
+        per_interface=args.per_interface,
+        release_fraction=args.release_fraction,
     )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # they are printed in the output
@@ -456,5 +589,14 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--damping-ratio", type=float, default=1.0, help="target zeta at omega_crit (default 1, critical)")
     p.add_argument("--points", type=int, default=2, help="interface points across the thickness (default 2)")
+    p.add_argument("--target-restitution", default=None, metavar="E",
+                   help="simulate the model (block, stack or façade of these inputs) and find the beta whose impacts "
+                        "give this apparent restitution: eta (Housner's e_eta), a multiple such as 0.95eta, or a "
+                        "number in (0, 1); a few seconds")
+    p.add_argument("--per-interface", action="store_true",
+                   help="each joint group pair its own critical beta = 2 zeta / sqrt(kn A / m) of its own impact "
+                        "(with --target-restitution: the targeted beta on the rocking interface, critical elsewhere)")
+    p.add_argument("--release-fraction", type=float, default=None,
+                   help="release of the targeted search's free-rocking probe, fraction of eta (default 0.5)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=_run)

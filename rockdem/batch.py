@@ -31,7 +31,7 @@ import numpy as np
 from .analysis import eta_of, lowest_vertex_height, summarize
 from .case import Case, CaseTemplate, template_key
 from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION
-from .results import block_eta, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
+from .results import block_eta, damping_attrs, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
 
 __all__ = ["Frames", "frames_from_dataset", "frames_from_run", "summary_row", "run_batch", "batch_row", "case_of", "TEMPLATE_CACHE"]
 
@@ -91,7 +91,7 @@ def frames_from_run(case: Case, out: Any) -> Frames:
     u_ground = ground_displacement(model, rec.position)
     mon = monitor_displacements(model, rel_ref, rec.position, out.monitors) - u_ground[:, None]
     m = model.arrays
-    attrs = {**out.attrs, "point_count": model.point_count, **case.attrs}
+    attrs = {**out.attrs, **damping_attrs(model), "point_count": model.point_count, **case.attrs}
     return Frames(
         rec.time, rocking_angles(model, rotvec), rec.position, rec.quaternion, mon, int(rec.counts[-1, COUNT_FAILED_SHEAR]),
         int(rec.counts[-1, COUNT_FAILED_TENSION]), np.asarray(m.block_free, dtype=bool), block_eta(model),
@@ -150,6 +150,12 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     row["dt_min"] = float(a["dt_min"])
     row["runtime_s"] = float(a["runtime_s"])
     row["kernel_s"] = float(a.get("kernel_s", a["runtime_s"]))
+    if a.get("beta_mode"):  # an automatic beta: the value chosen and how (rockdem.beta_choice)
+        row["beta_s"] = float(a["beta"])
+        row["beta_pairs"] = str(a["beta_pairs"])
+        for key in ("beta_target_value", "beta_achieved_e_a", "beta_iterations", "beta_search_time_s"):
+            if key in a:
+                row[key] = float(a[key])
     if spec.history:
         row["history"] = _history(spec, t, theta, f.monitor, a)
     return row
@@ -198,13 +204,14 @@ _STARTS: OrderedDict[str, Any] = OrderedDict()
 
 
 def _start(data: Mapping[str, Any], case: Case) -> Any:
-    """The run's :class:`rockdem.simulation.Start` (a copy), kept per specimen, damping and
-    timestep options: a derived case's model differs from its template's in the inputs only."""
+    """The run's :class:`rockdem.simulation.Start` (a copy), kept per specimen, damping (with the
+    per-pair betas of an automatic beta) and timestep options: a derived case's model differs from
+    its template's in the inputs only."""
     from .simulation import prepare_start
 
     r = case.run
-    key = json.dumps([template_key(data), case.model.damping.__dict__, r.timestep_rule, r.safety, r.resolution, r.dt],
-                     sort_keys=True, default=str)
+    key = json.dumps([template_key(data), case.model.damping.__dict__, case.model.arrays.mat_beta.tolist(), r.timestep_rule,
+                      r.safety, r.resolution, r.dt], sort_keys=True, default=str)
     with _LOCK:
         start = _STARTS.get(key)
         if start is not None:

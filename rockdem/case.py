@@ -12,6 +12,7 @@ import copy
 import json
 import math
 import os
+import threading
 import tomllib
 import warnings
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
 from .geometry import MAX_FACE_POINTS
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
@@ -491,18 +493,6 @@ def _run_options(top: Table) -> RunOptions:
     return run
 
 
-def _damping(top: Table) -> Damping:
-    damp_t = top.sub("damping")
-    damping = Damping(
-        alpha=damp_t.number("alpha", 0.0, min_=0.0),
-        beta=damp_t.number("beta", 0.0, min_=0.0),
-        alpha_relative=damp_t.boolean("alpha_relative", False),
-        local=damp_t.number("local", 0.0, min_=0.0),
-    )
-    damp_t.finish()
-    return damping
-
-
 def _specimen(top: Table) -> tuple[ModelBuilder, dict[str, Monitor]]:
     spec_t = top.sub("specimen")
     kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
@@ -572,7 +562,9 @@ class CaseTemplate:
     record, scale or PGA): :meth:`derive` validates such a case as :func:`parse_case` does and
     swaps the new damping and input arrays into the model (:meth:`rockdem.model.Model.with_inputs`)
     without rebuilding blocks, interface points or the contact geometry. The models are the ones
-    :func:`parse_case` builds, array for array.
+    :func:`parse_case` builds, array for array. An automatic beta (``beta = "auto"`` or
+    ``"critical"``, :mod:`rockdem.targeting`) is resolved once per distinct ``[damping]`` table and
+    kept: it depends on the specimen and the damping options, not on the record or its scale.
 
     Attributes:
         key: :func:`template_key` of the cases it serves.
@@ -585,7 +577,7 @@ class CaseTemplate:
         name = top.string("name", "case")
         top.string("description", "")
         run = _run_options(top)
-        damping = _damping(top)
+        damping = _damping(top.sub("damping"))
         builder, monitors = _specimen(top)
         load = top.data.get("loading", {})
         self._swap = isinstance(load, Mapping) and load.get("type") in SWAPPABLE_LOADINGS
@@ -597,7 +589,23 @@ class CaseTemplate:
         model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
                                  contact_tolerance=run.contact_tolerance)
         self._ctx = ctx
+        self._builder = builder  # what an automatic beta is resolved on
+        self._choices: dict[Damping, BetaChoice] = {damping: model.beta_choice} if model.beta_choice is not None else {}
+        self._lock = threading.Lock()  # Dask workers may derive in threads: one search per damping
         self.case = Case(name, model, run, dict(monitors), output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+    def beta_choice(self, damping: Damping) -> BetaChoice | None:
+        """The resolution of ``damping``'s automatic beta on this template's model (the search runs
+        once per distinct damping; :func:`rockdem.targeting.choose_beta`), None for a numeric beta."""
+        if damping.beta_mode is None:
+            return None
+        with self._lock:
+            choice = self._choices.get(damping)
+            if choice is None:
+                from .targeting import choose_beta  # runs simulations (imports simulate)
+
+                choice = self._choices[damping] = choose_beta(self._builder, self.case.model, damping)
+        return choice
 
     def derive(self, data: Mapping[str, Any]) -> Case:
         """The case of ``data`` (same :func:`template_key`), built on this template's model."""
@@ -607,7 +615,7 @@ class CaseTemplate:
         name = top.string("name", "case")
         top.string("description", "")
         run = _run_options(top)
-        damping = _damping(top)
+        damping = _damping(top.sub("damping"))
         top.used.add("specimen")  # equal to the template's (the key)
         model = self.case.model
         if self._swap:
@@ -615,14 +623,54 @@ class CaseTemplate:
             ctx = _loading(top, builder, monitors, run)
             if tuple(ctx.get("rocking_axis", (0.0, 1.0, 0.0))) != tuple(self._ctx.get("rocking_axis", (0.0, 1.0, 0.0))):
                 raise ValueError("CaseTemplate.derive: the loading changed the rocking axis")
-            model = model.with_inputs(damping=damping, builder=builder)
+            model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
         else:
             top.used.add("loading")
             ctx, monitors = self._ctx, dict(self.case.monitors)
-            model = model.with_inputs(damping=damping)
+            model = model.with_inputs(damping=damping, beta_choice=self.beta_choice(damping))
         output = _output(top)
         top.finish()
         return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+
+_AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")
+
+
+def _damping(t: Table) -> Damping:
+    """``[damping]``: alpha, beta (a number [s], ``"auto"`` or ``"critical"``), alpha_relative, local,
+    and for an automatic beta target_restitution, per_interface, release_fraction, probe_impacts
+    (``"auto"``) and damping_ratio (``"critical"``, and the other pairs of ``per_interface``)."""
+    raw = t.raw("beta", 0.0)
+    if isinstance(raw, str):
+        if raw not in BETA_MODES:
+            raise ValueError(
+                f"[{t.where}] beta must be a finite number [s], 'auto' (targeted to target_restitution) or 'critical' "
+                f"(each group pair 2 zeta / omega of its own impact), got {raw!r}"
+            )
+        beta: float | str = raw
+    else:
+        beta = t.number("beta", 0.0, min_=0.0)
+    given = [k for k in _AUTO_KEYS if k in t.data]
+    if given and beta != BETA_AUTO:
+        raise ValueError(f"[{t.where}] {', '.join(given)} only apply to beta = \"auto\" (beta is {beta!r}); set beta = \"auto\"")
+    if "damping_ratio" in t.data and not isinstance(beta, str):
+        raise ValueError(f"[{t.where}] damping_ratio only applies to beta = \"critical\" or \"auto\" (beta is {beta!r})")
+    target = t.raw("target_restitution", "0.95eta")
+    if isinstance(target, bool) or not isinstance(target, (str, int, float)):
+        raise ValueError(f"[{t.where}] target_restitution must be 'eta', a multiple such as '0.95eta', or a number in (0, 1), got {target!r}")
+    out = Damping(
+        alpha=t.number("alpha", 0.0, min_=0.0),
+        beta=beta,
+        alpha_relative=t.boolean("alpha_relative", False),
+        local=t.number("local", 0.0, min_=0.0),
+        target_restitution=target,
+        damping_ratio=t.number("damping_ratio", 1.0, positive=True),
+        per_interface=t.boolean("per_interface", False),
+        release_fraction=t.optional_number("release_fraction", positive=True),
+        probe_impacts=t.integer("probe_impacts", 0, min_=0),
+    )
+    t.finish()
+    return out
 
 
 def _register_builtin_types() -> None:

@@ -15,6 +15,7 @@ from typing import Any, Callable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .beta_choice import BETA_MODES, BetaChoice, RestitutionTarget
 from .flatten import BlockFrame, flatten_geometry
 from .geometry import MAX_FACE_POINTS, Polyhedron, box, mass_properties
 from .kernels.layout import ModelArrays
@@ -95,23 +96,58 @@ class Damping:
     Attributes:
         alpha: mass-proportional coefficient [1/s]: force -alpha m v, moment -alpha I omega.
         beta: stiffness-proportional coefficient [s]: dashpots beta kn A and beta ks A at every
-            active sub-contact (a joint material's own ``beta`` overrides it).
+            active sub-contact (a joint material's own ``beta`` overrides it). Or chosen by
+            :meth:`ModelBuilder.finalize` (``docs/damping.md``): ``"auto"``, the beta for which the
+            model's own impacts give the apparent restitution ``target_restitution``
+            (:mod:`rockdem.targeting`); ``"critical"``, every joint group pair its own
+            2 ``damping_ratio`` / omega of its own critical impact (:mod:`rockdem.interfaces`).
         alpha_relative: MP damping on velocities relative to the ground motion instead of absolute
             ones (3DEC uses absolute velocities).
         local: Cundall's local (non-viscous) damping coefficient for quasi-static runs only [-].
+        target_restitution: target of ``beta = "auto"``: ``"eta"`` (Housner's e_eta = 1 - 1.5
+            sin^2 eta of the released body), a multiple (``"0.95eta"``, Sorrentino et al.'s, the
+            default), or a restitution in (0, 1) (e.g. measured) [-].
+        damping_ratio: zeta of ``beta = "critical"`` and of the non-rocking pairs with
+            ``per_interface`` [-] (1 = critical).
+        per_interface: with ``beta = "auto"``, only the rocking interface(s) (the released body on
+            its supports) get the targeted beta, every other group pair its own critical beta;
+            without it every pair gets the targeted beta (one value, as in 3DEC).
+        release_fraction: release of the ``"auto"`` probe as a fraction of the instability angle
+            eta [-]; default the model's own free-rocking release (:meth:`ModelBuilder.tilt`),
+            else :data:`rockdem.targeting.DEFAULT_RELEASE_FRACTION`.
+        probe_impacts: impacts whose e_a the ``"auto"`` search matches to the target: 0 (default)
+            every half cycle of the probe's free-rocking decay down to 2 % of the release (the
+            mean e_a a free-rocking run reports), or the first N only (the large-amplitude
+            impacts; shorter probes).
     """
 
     alpha: float = 0.0
-    beta: float = 0.0
+    beta: float | str = 0.0
     alpha_relative: bool = False
     local: float = 0.0
+    target_restitution: float | str = "0.95eta"
+    damping_ratio: float = 1.0
+    per_interface: bool = False
+    release_fraction: float | None = None
+    probe_impacts: int = 0
 
     def __post_init__(self) -> None:
         self.validate()
 
+    @property
+    def beta_mode(self) -> str | None:
+        """``"auto"`` or ``"critical"`` when beta is chosen at :meth:`ModelBuilder.finalize`, else None."""
+        return self.beta if isinstance(self.beta, str) else None
+
     def validate(self) -> None:
         """Raise ValueError naming the field for a negative, non-finite or non-numeric value."""
-        for name in ("alpha", "beta", "local"):
+        names = ("alpha", "local") if isinstance(self.beta, str) else ("alpha", "beta", "local")
+        if isinstance(self.beta, str) and self.beta not in BETA_MODES:
+            raise ValueError(
+                f"damping.beta must be a non-negative number [s], 'auto' (targeted to damping.target_restitution) "
+                f"or 'critical' (per group pair, 2 zeta / omega), got {self.beta!r}"
+            )
+        for name in names:
             v = getattr(self, name)
             if not real_number(v, f"damping.{name}") >= 0.0:
                 raise ValueError(f"damping.{name} must be a finite non-negative number, got {v!r}")
@@ -119,6 +155,45 @@ class Damping:
             raise ValueError(f"damping.alpha_relative must be True or False, got {self.alpha_relative!r}")
         if self.local >= 1.0:
             raise ValueError(f"damping.local must be below 1 (0.8 is usual for quasi-static runs), got {self.local!r}")
+        RestitutionTarget.parse(self.target_restitution)
+        if not real_number(self.damping_ratio, "damping.damping_ratio") > 0.0:
+            raise ValueError(f"damping.damping_ratio must be positive (1 = critical), got {self.damping_ratio!r}")
+        if not isinstance(self.per_interface, (bool, np.bool_)):
+            raise ValueError(f"damping.per_interface must be True or False, got {self.per_interface!r}")
+        if self.release_fraction is not None and not 0.0 < real_number(self.release_fraction, "damping.release_fraction") < 1.0:
+            raise ValueError(f"damping.release_fraction must lie in (0, 1) (a fraction of eta), got {self.release_fraction!r}")
+        if isinstance(self.probe_impacts, bool) or not isinstance(self.probe_impacts, (int, np.integer)) or self.probe_impacts < 0:
+            raise ValueError(f"damping.probe_impacts must be an integer >= 0 (0: the whole decay), got {self.probe_impacts!r}")
+
+
+@dataclass(frozen=True)
+class Release:
+    """A free-rocking release recorded by :meth:`ModelBuilder.tilt`.
+
+    Attributes:
+        blocks: names of the blocks tilted as one rigid assembly.
+        fraction: tilt as a fraction of the assembly's instability angle [-].
+        direction: (3,) horizontal unit direction towards which the top moved.
+    """
+
+    blocks: tuple[str, ...]
+    fraction: float
+    direction: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ReleaseGeometry:
+    """Where and how far an assembly was tilted (:meth:`ModelBuilder.released_copy`).
+
+    Attributes:
+        angle: tilt angle theta_0 [rad]. eta: the assembly's instability angle about the pivot [rad].
+        pivot: (3,) a point of the pivot edge [m]. axis: (3,) unit rotation axis of the tilt.
+    """
+
+    angle: float
+    eta: float
+    pivot: NDArray[np.float64]
+    axis: NDArray[np.float64]
 
 
 @dataclass
@@ -156,6 +231,8 @@ class Model:
         damping: the damping options.
         rocking_axis: (3,) world axis about which ``rocking_angle`` is measured.
         materials: the material table by group-name pair.
+        beta_choice: how beta was chosen when ``damping.beta`` was ``"auto"`` or ``"critical"``
+            (``damping.beta`` then holds the chosen value), else None.
     """
 
     arrays: ModelArrays
@@ -171,6 +248,7 @@ class Model:
     damping: Damping
     rocking_axis: NDArray[np.float64]
     materials: dict[tuple[str, str], JointMaterial] = field(default_factory=dict)
+    beta_choice: BetaChoice | None = None
 
     @property
     def block_count(self) -> int:
@@ -180,19 +258,39 @@ class Model:
     def point_count(self) -> int:
         return int(self.arrays.point_area.shape[0])
 
-    def with_inputs(self, *, damping: Damping | None = None, builder: ModelBuilder | None = None) -> Model:
+    def with_inputs(
+        self, *, damping: Damping | None = None, builder: ModelBuilder | None = None, beta_choice: BetaChoice | None = None
+    ) -> Model:
         """This model with another damping and/or the prescribed kinematics (ground motion, body
         acceleration, driven motions) of ``builder``, whose blocks must be this model's: the
-        geometry is not rebuilt. The arrays are those :meth:`ModelBuilder.finalize` would give."""
+        geometry is not rebuilt. The arrays are those :meth:`ModelBuilder.finalize` would give.
+
+        A damping whose beta is ``"auto"`` or ``"critical"`` needs ``beta_choice``, its resolution on
+        this model's builder (:func:`rockdem.targeting.choose_beta`; :class:`rockdem.case.CaseTemplate`
+        keeps one per damping); the model then carries the chosen betas as ``finalize`` leaves them.
+        """
         fields: dict[str, Any] = {}
+        new_damping, choice = self.damping, self.beta_choice
         if damping is not None:
             damping.validate()
-            fields.update(damping_arrays(self.materials, self.group_names, damping))
+            if beta_choice is not None and beta_choice.mode != damping.beta_mode:
+                raise ValueError(f"with_inputs: beta_choice is the resolution of beta = {beta_choice.mode!r}, "
+                                 f"but damping.beta is {damping.beta!r}")
+            if damping.beta_mode is not None and beta_choice is None:
+                raise ValueError(
+                    f"with_inputs: damping.beta = {damping.beta!r} is chosen from the model's builder; pass "
+                    "beta_choice=rockdem.targeting.choose_beta(builder, model, damping) or use ModelBuilder.finalize"
+                )
+            fields.update(damping_arrays(self.materials, self.group_names, damping, beta_choice))
+            new_damping = damping if beta_choice is None else replace(damping, beta=beta_choice.beta)
+            choice = beta_choice
+        elif beta_choice is not None:
+            raise ValueError("with_inputs: beta_choice goes with the damping it resolves (give damping=)")
         if builder is not None:
             if tuple(builder.block_names()) != self.block_names:
                 raise ValueError("with_inputs: the builder's blocks are not this model's")
             fields.update(builder.input_arrays())
-        return replace(self, arrays=self.arrays._replace(**fields), damping=damping if damping is not None else self.damping)
+        return replace(self, arrays=self.arrays._replace(**fields), damping=new_damping, beta_choice=choice)
 
     def summary(self) -> dict[str, str]:
         """Short description, label -> text: blocks, points, groups, joints, damping, loading, size."""
@@ -228,7 +326,9 @@ class Model:
             "interface points": f"{self.point_count}",
             "groups": ", ".join(self.group_names),
             "joints": f"kn {'/'.join(kn)} Pa/m, friction {'/'.join(phi)} deg",
-            "damping": f"alpha {d.alpha:g} 1/s, beta {d.beta:g} s" + (f", local {d.local:g}" if d.local else ""),
+            "damping": f"alpha {d.alpha:g} 1/s, beta {d.beta:g} s"
+            + (f" (beta = \"{self.beta_choice.mode}\")" if self.beta_choice is not None else "")
+            + (f", local {d.local:g}" if d.local else ""),
             "loading": ", ".join(loading) or "gravity only",
         }
 
@@ -281,6 +381,12 @@ class ModelBuilder:
         self._default_material: JointMaterial | None = None
         self.ground_motion: Motion | None = None
         self.body_acceleration: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+        self._release: Release | None = None
+
+    @property
+    def release(self) -> Release | None:
+        """The last free-rocking release made by :meth:`tilt` (None: the blocks were not tilted)."""
+        return self._release
 
     @property
     def default_material(self) -> JointMaterial | None:
@@ -435,12 +541,27 @@ class ModelBuilder:
         if isinstance(fraction, bool) or not (isinstance(fraction, (int, float)) and math.isfinite(fraction) and 0.0 <= fraction):
             raise ValueError(f"tilt fraction must be >= 0 (0.9 = 90 % of the instability angle), got {fraction!r}")
         d = _vector3(direction, "tilt direction")
+        geo = self._tilt(ids, fraction, d)
+        self._release = Release(tuple(b.name for b in blocks), float(fraction), self._horizontal(d))
+        return geo.angle
+
+    def _up(self) -> NDArray[np.float64]:
         gn = np.linalg.norm(self.gravity)
-        up = -self.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
-        d = d - up * (up @ d)
+        return -self.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
+
+    def _horizontal(self, direction: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``direction`` projected on the horizontal plane, unit length."""
+        up = self._up()
+        d = direction - up * (up @ direction)
         if not np.linalg.norm(d) > 0:
             raise ValueError("tilt direction must have a horizontal component")
-        d /= np.linalg.norm(d)
+        return d / np.linalg.norm(d)
+
+    def _tilt(self, ids: list[int], fraction: float, direction: NDArray[np.float64]) -> ReleaseGeometry:
+        """Turn blocks ``ids`` as one rigid assembly about their pivot edge (see :meth:`tilt`)."""
+        blocks = [self._blocks[k] for k in ids]
+        up = self._up()
+        d = self._horizontal(direction)
         v = np.vstack([b.poly.vertices for b in blocks])
         size = max(b.poly.size for b in blocks)
         h = v @ up
@@ -458,13 +579,47 @@ class ModelBuilder:
                 f"tilt fraction {fraction!r} of the instability angle ({math.degrees(eta):.3g} deg) tilts the blocks "
                 "by 90 deg or more; give a fraction below 1 for a release from rest (paper §3.1)"
             )
-        r = axis_angle_matrix(np.cross(up, d), theta)
+        axis = np.cross(up, d)
+        r = axis_angle_matrix(axis, theta)
         for k, blk in zip(ids, blocks):
             if blk.reference is None:
                 blk.reference = blk.poly
             self.transform_block(k, r, about=pivot)
             blk.tilt = r @ blk.tilt
-        return theta
+        return ReleaseGeometry(theta, eta, pivot, axis)
+
+    def reference_poly(self, i: int | str) -> Polyhedron:
+        """Geometry of block ``i`` in its reference pose (before any :meth:`tilt`) [m]."""
+        blk = self._blocks[self._index(i)]
+        return blk.poly if blk.reference is None else blk.reference
+
+    def released_copy(
+        self, blocks: Sequence[str], fraction: float, direction: ArrayLike, *, keep: Sequence[str] | None = None
+    ) -> tuple["ModelBuilder", ReleaseGeometry]:
+        """A copy of this builder for a free-rocking probe (the ``beta = "auto"`` search).
+
+        In the copy every block is in its reference (untilted) pose, at rest, driven blocks are fixed,
+        there is no ground motion or body acceleration, only the blocks ``keep`` (default all) remain,
+        and ``blocks`` are tilted as one rigid assembly to ``fraction`` of their instability angle
+        towards ``direction`` (as :meth:`tilt`). Materials and groups are shared with this builder.
+
+        Returns:
+            The copy and the release's geometry (angle, eta, pivot, axis).
+        """
+        names = set(self.block_names()) if keep is None else set(keep) | set(blocks)
+        out = ModelBuilder(gravity=self.gravity.copy(), points=self.points)
+        out._materials = dict(self._materials)
+        out._default_material = self._default_material
+        for blk in self._blocks:
+            if blk.name not in names:
+                continue
+            out._blocks.append(
+                _Block(blk.name, self.reference_poly(blk.name), blk.density, blk.group,
+                       blk.driven if blk.driven is False else True, blk.points, np.zeros(3), np.zeros(3))
+            )
+        ids = [out._index(n) for n in blocks]
+        geo = out._tilt(ids, fraction, _vector3(direction, "release direction"))
+        return out, geo
 
     # -- materials and loading ----------------------------------------------------------------
     def set_material(self, group_a: str, group_b: str, material: JointMaterial) -> None:
@@ -654,7 +809,7 @@ class ModelBuilder:
             touch_tol=0.1 * float(contact_tolerance),
             **_extent(geometry["vertex_local"], geometry["block_vertex_start"], pos0, quat0, free_mask),
         )
-        return Model(
+        model = Model(
             arrays=arrays,
             block_names=tuple(b.name for b in self._blocks),
             group_names=tuple(groups),
@@ -669,6 +824,11 @@ class ModelBuilder:
             rocking_axis=axis / np.linalg.norm(axis),
             materials=mats,
         )
+        if damping.beta_mode is None:
+            return model
+        from .targeting import choose_beta  # runs simulations of the model (imports simulate)
+
+        return model.with_inputs(damping=damping, beta_choice=choose_beta(self, model))
 
     def _index(self, i: int | str) -> int:
         if isinstance(i, str):
@@ -681,13 +841,23 @@ class ModelBuilder:
         return i
 
 
-def damping_arrays(materials: Mapping[tuple[str, str], JointMaterial], group_names: Sequence[str], damping: Damping) -> dict[str, Any]:
-    """The damping fields of :class:`ModelArrays`: ``mat_beta`` (ng, ng) [s] (a material's own
-    beta, else ``damping.beta``), ``alpha`` [1/s], ``alpha_relative``, ``local_damping``."""
+def damping_arrays(
+    materials: Mapping[tuple[str, str], JointMaterial],
+    group_names: Sequence[str],
+    damping: Damping,
+    beta_choice: BetaChoice | None = None,
+) -> dict[str, Any]:
+    """The damping fields of :class:`ModelArrays`: ``mat_beta`` (ng, ng) [s], ``alpha`` [1/s],
+    ``alpha_relative``, ``local_damping``. ``mat_beta`` holds each pair's beta of ``beta_choice``
+    when given (an automatic beta resolved), else a material's own beta, else ``damping.beta``
+    (0 while ``damping.beta`` is ``"auto"`` or ``"critical"`` and not yet resolved)."""
     gi = {g: k for k, g in enumerate(group_names)}
     beta = np.zeros((len(group_names), len(group_names)))
     for (ga, gb), mat in materials.items():
-        beta[gi[ga], gi[gb]] = damping.beta if mat.beta is None else mat.beta
+        if beta_choice is not None:
+            beta[gi[ga], gi[gb]] = beta_choice.pair(ga, gb).beta
+        else:
+            beta[gi[ga], gi[gb]] = (0.0 if damping.beta_mode else damping.beta) if mat.beta is None else mat.beta
     return {
         "mat_beta": beta,
         "alpha": float(damping.alpha),

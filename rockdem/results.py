@@ -28,7 +28,11 @@ Variables (dims; units in each variable's ``units`` attribute):
   static: block_mass, block_free, block_group, block_name (block); the geometry for plots and
   VTK: vertex_local (vertex, xyz) [m] in the body frames, face_vertex (corner) global vertex ids,
   face_corner_start (face+1), block_face_start (block+1), point_count (block).
-Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, displacement_reference, ...
+Attributes: dt, steps, runtime_s, rocking_axis, gravity, alpha, beta, displacement_reference, ...;
+with ``damping.beta = "auto"`` or ``"critical"`` also how beta was chosen: beta_mode, beta_pairs,
+beta_how, and for "auto" beta_target_restitution, beta_target_value, beta_achieved_e_a,
+beta_iterations, beta_search_beta / beta_search_e_a (every probe run), beta_search_time_s
+(:meth:`rockdem.beta_choice.BetaChoice.attrs`).
 
 Response displacements are relative to the ground by default. Under an earthquake applied as
 foundation motion (``mode="foundation"``) the ground-following blocks move with the record's
@@ -46,7 +50,7 @@ from __future__ import annotations
 import os
 import uuid
 from pathlib import Path
-from typing import TYPE_CHECKING, Mapping, NamedTuple
+from typing import TYPE_CHECKING, Any, Mapping, NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -60,6 +64,7 @@ from .model import Model
 
 __all__ = [
     "build_dataset",
+    "damping_attrs",
     "block_eta",
     "block_thickness",
     "Pivot",
@@ -170,10 +175,7 @@ def build_dataset(
         {
             "rocking_axis": axis.tolist(),
             "gravity": m.gravity.tolist(),
-            "alpha": model.damping.alpha,
-            "beta": model.damping.beta,
-            "alpha_relative": int(model.damping.alpha_relative),
-            "local_damping": model.damping.local,
+            **damping_attrs(model),
             "point_count": model.point_count,
             "contact_tolerance": m.contact_tol,
             "rockdem_version": _version(),
@@ -181,6 +183,18 @@ def build_dataset(
         }
     )
     return ds
+
+
+def damping_attrs(model: Model) -> dict[str, Any]:
+    """A result's damping attributes: alpha [1/s], beta [s] (the chosen one for an automatic beta),
+    alpha_relative, local_damping, and how an automatic beta was chosen
+    (:meth:`rockdem.beta_choice.BetaChoice.attrs`). ``build_dataset`` and the batch path's
+    summary rows (:func:`rockdem.batch.frames_from_run`) both use it."""
+    d = model.damping
+    out: dict[str, Any] = {"alpha": d.alpha, "beta": d.beta, "alpha_relative": int(d.alpha_relative), "local_damping": d.local}
+    if model.beta_choice is not None:
+        out.update(model.beta_choice.attrs())
+    return out
 
 
 def reference_rotations(model: Model, quaternion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

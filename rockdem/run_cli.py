@@ -92,6 +92,16 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         _row("timestep", f"{a['dt']:.4e}", "s", f"smallest {a.get('dt_min', a['dt']):.4e} s, rule {a.get('timestep_rule', '?')}"),
         _row("time simulated", f"{float(ds.time[-1]) if n else 0.0:.4f}", "s", f"{n} frames, run time {a.get('runtime_s', 0.0):.3f} s"),
     ]
+    if a.get("beta_mode") == "auto":
+        lines.append(_row("beta (targeted)", f"{float(a['beta']):.5g}", "s",
+                          f"mean e_a {float(a['beta_achieved_e_a']):.4f} for target {a['beta_target_restitution']} = "
+                          f"{float(a['beta_target_value']):.4f}, {int(a['beta_iterations'])} probe runs, "
+                          f"{float(a['beta_search_time_s']):.2g} s"))
+    if a.get("beta_mode"):
+        for pair in str(a.get("beta_pairs", "")).split("; "):
+            if pair and "no free block" not in pair and "no contact possible" not in pair:
+                label, value = pair.split(": ", 1)
+                lines.append(_row(f"beta {label}", value.split(" s ")[0], "s", value.split(" s ", 1)[-1].strip("()")))
     free = np.flatnonzero(ds.block_free.values)
     b = peak_block = int(free[0]) if len(free) else 0
     if n and len(free):

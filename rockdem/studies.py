@@ -62,7 +62,7 @@ __all__ = [
     "register_cli",
 ]
 
-TIMING_COLUMNS = ("runtime_s", "kernel_s", "wall_s", "cpu_s")
+TIMING_COLUMNS = ("runtime_s", "kernel_s", "wall_s", "cpu_s", "beta_search_time_s")
 """Row entries that measure time and therefore differ between otherwise identical runs."""
 
 EXECUTORS = ("process", "serial", "dask")
@@ -233,7 +233,9 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     ``failed_tension_fraction``, ``steps``, ``dt`` (the starting timestep), ``dt_min`` (the
     smallest, after any lowering at contact detections), ``runtime_s`` (engine loop), ``kernel_s``
     (inside the compiled kernel), ``wall_s`` (whole run), ``cpu_s`` (its processor time), and
-    ``history`` when asked for.
+    ``history`` when asked for; with ``damping.beta = "auto"`` or ``"critical"`` also ``beta_s``,
+    ``beta_pairs`` and for "auto" ``beta_target_value``, ``beta_achieved_e_a``, ``beta_iterations``,
+    ``beta_search_time_s`` (the search's time, run once per specimen and damping on the batch path).
     """
     from .batch import frames_from_dataset, summary_row
     from .run_cli import run_case

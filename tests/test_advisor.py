@@ -205,3 +205,37 @@ def test_advisor_texts_cite_the_paper_not_internal_documents() -> None:
     adv = advise(**FACADE)
     texts = [src for *_, src in adv.rows()] + list(adv.recommendations) + [adv.table()]
     assert not any("DESIGN" in t or "issue" in t.lower() for t in texts)
+
+
+def test_advisor_targets_the_restitution_and_says_which_beta_and_why(capsys: pytest.CaptureFixture[str]) -> None:
+    # --target-restitution: the advisor simulates the block the inputs describe and recommends the
+    # beta whose free-rocking impacts give that mean e_a (Eq. 6), with the target, what was
+    # achieved and the equations; without it, DeJong's rule (Eq. 3) and why.
+    block = ["advise", "--width", "0.2", "--height", "2", "--density", "1800", "--youngs-modulus-mpa", "1800"]
+    assert main(block + ["--target-restitution", "eta", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    mb = data["model_beta"]
+    e_eta = 1 - 1.5 * math.sin(math.atan(0.1)) ** 2
+    assert mb["mode"] == "auto" and mb["target"] == "eta" and mb["target_value"] == pytest.approx(e_eta)
+    assert abs(mb["achieved_e_a"] / e_eta - 1) < 0.01 and mb["probe_runs"] >= 2
+    assert data["recommended_beta"]["value"] == mb["beta_s"] and data["recommended_beta"]["unit"] == "s"
+    assert "Eq. 6" in data["recommended_beta"]["why"]
+    plain = advise(width=0.2, height=2.0, density=1800.0, youngs_modulus=1.8e9)
+    assert plain.recommended_beta == plain.beta_sp and "Eq. 3" in plain.recommended_why
+    assert main(block + ["--target-restitution", "fast"]) == 2
+    assert "target_restitution" in capsys.readouterr().err
+
+
+def test_advisor_per_interface_betas_of_a_one_sided_facade(capsys: pytest.CaptureFixture[str]) -> None:
+    # each pair beta = 2 zeta / omega, omega = sqrt(kn A / m) with kn = E / H (paper Eq. 1-4, §2.2):
+    # the base (B x L) and both return walls' end faces (2 x 0.11 m x H, the façade builder's walls)
+    adv = advise(**FACADE, configuration="one-sided", per_interface=True)
+    c = adv.beta_choice
+    m, kn = 1750 * 0.11 * 0.8 * 1.5, 1.8e9 / 0.8
+    base, ret = c.pair("facade", "foundation"), c.pair("facade", "return")
+    assert base.beta == pytest.approx(2 / math.sqrt(kn * 0.11 * 1.5 / m), rel=1e-9)
+    assert ret.beta == pytest.approx(2 / math.sqrt(kn * 2 * 0.11 * 0.8 / m), rel=1e-9)
+    assert adv.recommended_beta == max(base.beta, ret.beta)
+    assert "sqrt(kn A / m)" in base.how and "per interface" in adv.recommended_why.lower()
+    text = adv.table()
+    assert "Recommended beta" in text and "facade-return: beta" in text

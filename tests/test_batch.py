@@ -117,3 +117,64 @@ def test_start_is_copied_not_shared(base):
     assert copy.timestep == start.timestep
     for a, b in zip(copy.state + copy.scratch, start.state + start.scratch):
         assert a is not b and np.array_equal(a, b)
+
+
+AUTO = {"damping.beta": "auto", "damping.target_restitution": "eta", "damping.probe_impacts": 2, "damping.release_fraction": 0.5}
+
+
+def _choice_attrs(model):
+    return {k: v.tolist() if isinstance(v, np.ndarray) else v
+            for k, v in model.beta_choice.attrs().items() if k not in ("beta_search_time_s", "beta_how")}
+
+
+def test_derived_models_with_an_automatic_beta_are_the_parsed_models(base):
+    """beta = "critical" / "auto" derived from a template of another damping (and back to a number):
+    parse_case's arrays, damping and beta choice; the numeric one keeps no choice of the template's."""
+    data = RunSpec.make(base, SMALL, record="elcentro-rsn6", pga_g=0.2).case_dict()
+    tpl = CaseTemplate(data)
+    for over in ({"damping.beta": "critical"}, AUTO, {"damping.beta": 0.002}):
+        other = apply_overrides(data, [f"{k}={v!r}" if isinstance(v, str) else f"{k}={v}" for k, v in over.items()]
+                                + ['loading.record="elcentro-peknold"'])
+        derived, parsed = tpl.derive(other), parse_case(other)
+        for name, a, b in zip(parsed.model.arrays._fields, derived.model.arrays, parsed.model.arrays):
+            assert np.array_equal(a, b), name
+        assert derived.model.damping == parsed.model.damping
+        if parsed.model.beta_choice is None:
+            assert derived.model.beta_choice is None and over["damping.beta"] == 0.002
+        else:
+            assert _choice_attrs(derived.model) == _choice_attrs(parsed.model)
+            assert derived.model.damping.beta == parsed.model.beta_choice.beta > 0
+
+
+def test_automatic_beta_sweep_rows_by_both_paths(base, monkeypatch):
+    """A sweep over records and PGAs with beta = "critical", a number and beta = "auto", interleaved
+    on one specimen: the batch path resolves each automatic beta once (not per run) and gives the
+    single runs' rows, the chosen beta and its search record included."""
+    from collections import OrderedDict
+
+    from rockdem import batch, targeting
+    from rockdem.beta_choice import housner_e_eta
+
+    calls = []
+    choose = targeting.choose_beta
+    monkeypatch.setattr(targeting, "choose_beta", lambda *a, **k: calls.append(1) or choose(*a, **k))
+    monkeypatch.setattr(batch, "_TEMPLATES", OrderedDict())
+    monkeypatch.setattr(batch, "_STARTS", OrderedDict())
+    eq = {**SMALL, "run.stop": "decided"}
+    dampings = ({"damping.beta": "critical"}, {"damping.beta": 0.0005}, AUTO)
+    specs = [RunSpec.make(base, {**eq, **d}, duration=1.5, record=r, pga_g=p)
+             for r in ("elcentro-rsn6", "elcentro-peknold") for p in (0.5, 1.0) for d in dampings]
+    rows = run_batch(specs)
+    assert len(calls) == 2  # one critical, one targeted resolution for 12 runs
+    single = [run_spec(s) for s in specs]
+    assert len(calls) == 2 + 8  # a single run resolves its own
+    for s, a, b in zip(specs, single, rows):
+        assert b["status"] == "ok" and _strip(a) == _strip(b), s.inputs
+    by = {d["damping.beta"]: [r for r in rows if r["damping.beta"] == d["damping.beta"]] for d in dampings}
+    assert "beta_s" not in by[0.0005][0]
+    crit, auto = by["critical"], by["auto"]
+    assert len({r["beta_s"] for r in crit}) == 1 and "block-foundation" in crit[0]["beta_pairs"] and "(critical)" in crit[0]["beta_pairs"]
+    assert len({(r["beta_s"], r["beta_search_time_s"]) for r in auto}) == 1  # one search, its record on every row
+    assert auto[0]["beta_target_value"] == pytest.approx(housner_e_eta(np.arctan2(0.19, 0.5)))
+    assert abs(auto[0]["beta_achieved_e_a"] / auto[0]["beta_target_value"] - 1) < 0.01
+    assert {r["steps"] for r in crit} != {r["steps"] for r in by[0.0005]}  # the chosen beta is the one run

@@ -31,7 +31,7 @@ from ..studies import RunSpec, Store, execute
 
 __all__ = ["Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
 
-STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16")
+STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16", "damping")
 """Modules of :mod:`rockdem.reproduce` that register studies (imported on first use)."""
 
 DEFAULT_OUT = Path("docs") / "reproduction"

@@ -26,6 +26,11 @@ PARAPET_ALPHA = 0.0753  # 1/s (MP)
 PARAPET_BETA = 0.00068  # s (SP); the §2.2 formula gave beta = 0.00305 s (overdamped)
 PARAPET_BETA_FORMULA = 0.00305  # s
 FACADE_BETA = 0.00025  # s, §4.3: free rocking of the non-deteriorated one-sided wall
+# §4.2: the §2 formula's beta for the façade (B = 0.11, H = 0.8, L = 1.5 m, 1750 kg/m^3, E = 1800 MPa)
+FACADE_BETA_ONE_SIDED = 0.00017  # s, one-sided (return-wall impact, B and H swapped, x sqrt 2)
+FACADE_BETA_TWO_SIDED = 0.00470  # s, two-sided rocking block
+FACADE_BETAS_UNDERDAMPED_TAIL = (0.000125, 0.00025, 0.0005, 0.001)  # s: late motion left undamped
+FACADE_BETAS_OVERDAMPED = (0.002, 0.004, 0.0058)  # s: over-damped after the first impact
 
 # §3.2.1 / Table 1: discretised blocks, no viscous damping, joints that do not fail, base friction
 # angle 31 deg; e_eta = 1 - 1.5 sin^2(eta) and 95 % of it.
