@@ -90,9 +90,9 @@ def simulate(
         safety: fraction of the stable bound for the automatic timestep (default 0.9).
         resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
             keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
-        record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
-            the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
-            within half a step of it.
+        record_interval: time between recorded frames [s] (default 0.002). The engine shortens
+            the step that would pass a frame's time so that frame k is recorded at k
+            record_interval (to round-off; no step shorter than half the timestep).
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
             configuration (before any initial tilt); displacements are measured from there.

@@ -283,6 +283,25 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     return STATUS_DONE
 
 
+FRAME_TOL = 1e-6
+"""A step this close (in steps) to a frame's time records that frame (round-off of the landing)."""
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def frame_step(t: float, dt: float, t_frame: float) -> float:
+    """Length of the step from time t [s]: dt, shortened so that a step lands on the next frame time
+    ``t_frame`` and frames are recorded at exact multiples of the record interval. A remainder
+    shorter than half a step is avoided by splitting the last stretch into two equal steps, so no
+    step is shorter than dt / 2 (the variable-step leapfrog stays second order: velocities use the
+    mean of the two step lengths)."""
+    r = t_frame - t
+    if 0.0 < r <= dt:
+        return r
+    if dt < r < 1.5 * dt:
+        return 0.5 * r
+    return dt
+
+
 @njit(cache=True, _nrt=False)
 def advance(
     m: ModelArrays, s: State, sc: Scratch, t_stop: float, record_interval: float, rec: Records, frame: int
@@ -294,8 +313,8 @@ def advance(
     recording the first bad frame (see :func:`check_frame`). After each detection the bound of the
     tracked contacts is recomputed and dt is lowered (never raised) to (2 / omega_max)
     min(safety f_SP, resolution) (:mod:`rockdem.timestep`), so that contacts stiffer than those at
-    the start (a toppling block landing on a side face) stay stable and resolved. Velocities use
-    the mean of the two step lengths.
+    the start (a toppling block landing on a side face) stay stable and resolved. Steps land on the
+    frame times (:func:`frame_step`); velocities use the mean of the two step lengths.
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
@@ -316,16 +335,17 @@ def advance(
                 s.dt_min[0] = min(s.dt_min[0], safe)
         t = s.time[0]
         dt = s.dt[0]
-        h = 0.5 * (s.dt_prev[0] + dt)
-        compute_forces(m, s, sc, t, s.dt_prev[0])
         now = -1
-        if frame < rec.time.shape[0] and t >= frame * record_interval - 0.5 * dt:
+        if frame < rec.time.shape[0] and t >= frame * record_interval - FRAME_TOL * dt:
             now = frame
+        step = frame_step(t, dt, (frame + 1 if now >= 0 else frame) * record_interval)
+        h = 0.5 * (s.dt_prev[0] + step)
+        compute_forces(m, s, sc, t, s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, now)
         dashpot_work(m, s, sc, h)
-        integrate_positions(m, s, dt)
-        s.dt_prev[0] = dt
-        s.time[0] = t + dt
+        integrate_positions(m, s, step)
+        s.dt_prev[0] = step
+        s.time[0] = t + step
         s.step[0] += 1
         if now >= 0:
             frame += 1
