@@ -43,14 +43,16 @@ def test_stop_modes_are_checked():
 
 def test_block_released_beyond_eta_stops_at_the_first_frame_past_eta():
     """Free rocking from 1.02 eta: with no ground motion phi_c = 0, so the collapse is decided at the
-    first frame past eta moving away (frame 1: it starts there). The full run ends fallen (it tumbles about pi/2 on the
-    ground); the stopped run's frames are the full run's up to there, bit for bit."""
+    first frame past eta moving away (frame 1: it starts there). The full run ends fallen (it tumbles about pi/2 and
+    bounces on its side on the ground); the stopped run's frames are the full run's up to there, bit for bit."""
     case = _case(**{"loading.tilt_fraction": 1.02})
     full = _run(case, 3.0, "off")
     stopped = _run(case, 3.0, "decided")
     eta = float(full.block_eta.values[1])
     theta = full.rocking_angle.values[:, 1]
-    assert abs(theta[-1]) > 3 * eta and full.block_position.values[-1, 1, 2] < 0.5 * full.block_position.values[0, 1, 2]
+    # Undamped, it keeps bouncing on its side: it lies on the ground within the last second.
+    late = full.time.values > full.time.values[-1] - 1.0
+    assert abs(theta[-1]) > 3 * eta and full.block_position.values[late, 1, 2].min() < 0.5 * full.block_position.values[0, 1, 2]
     a = stopped.attrs
     assert a["stop_reason"] == "overturned" and a["stop_block"] == "block"
     n = stopped.sizes["time"]
