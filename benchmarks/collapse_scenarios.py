@@ -134,7 +134,7 @@ def random_pile(short: bool = False, *, count: int = 40, seed: int = 7) -> Scena
         cx, cy = (slot % 3 - 1) * spacing + rng.uniform(-0.05, 0.05), (slot // 3 - 1) * spacing + rng.uniform(-0.05, 0.05)
         poly = box(*dims, name=f"box{k}").transformed(r, [cx, cy, 0.3 + layer * spacing])
         b.add_block(poly, density=2000, name=f"box{k}")
-    return Scenario("random_pile", b.finalize(damping=Damping(alpha=2.0, beta=2e-4)), 1.5 if short else 4.0, 0.005,
+    return Scenario("random_pile", b.finalize(damping=Damping(alpha=2.0, beta=2e-4)), 2.0 if short else 4.0, 0.005,
                     f"{n} random boxes dropped on the ground")
 
 

@@ -592,7 +592,9 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
 
 @njit(cache=True, _nrt=False)
 def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
-    """Forces and torques on every block at the current poses (DESIGN: engine, joint law of paper §3)."""
+    """Forces and torques on every block at the current poses (joint law of paper §3); ``t`` [s] is
+    the time at which body loads (inertial earthquake loading) are sampled, ``dt`` [s] the step
+    just taken."""
     nb = m.block_mass.shape[0]
     sc.force[:] = 0.0
     sc.torque[:] = 0.0

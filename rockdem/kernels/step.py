@@ -55,9 +55,11 @@ DIVERGENCE_ERROR = 0.2
 
 @njit(cache=True, _nrt=False)
 def integrate_velocities(
-    m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int
+    m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int, step: float
 ) -> None:
-    """v_{n-1/2} -> v_{n+1/2} for every block; records frame ``frame`` (if >= 0) at t_n."""
+    """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` (the mean of the last and the next step)
+    ; a driven block takes its prescribed velocity at the middle of the next position step
+    ``step`` [s]; records frame ``frame`` (if >= 0) at t_n."""
     nb = m.block_mass.shape[0]
     alpha = m.alpha
     ha = 0.5 * alpha * dt
@@ -68,6 +70,10 @@ def integrate_velocities(
     else:
         vg[:] = 0.0
     vd = sc.driven_velocity
+    # The velocity at t_n: the half-step velocities at t_n - dt_prev / 2 and t_n + step / 2
+    # interpolated (their mean when the two steps are equal; dt is their mean).
+    w_new = 1.0 - 0.5 * step / dt
+    w_old = 1.0 - w_new
     ke = 0.0
     pe = 0.0
     e_mp = 0.0
@@ -88,7 +94,7 @@ def integrate_velocities(
                     e_loc += abs(fl * s.velocity[b, i]) * dt
                 vold = s.velocity[b, i]
                 vnew = (vold * (1.0 - ha) + dt * fi * m.block_inv_mass[b] + 2.0 * ha * vg[i]) / (1.0 + ha)
-                va[i] = 0.5 * (vold + vnew)
+                va[i] = w_old * vold + w_new * vnew
                 s.velocity[b, i] = vnew
                 e_mp += alpha * mass * (va[i] - vg[i]) ** 2 * dt
                 w_body += mass * sc.body_acc[i] * va[i] * dt
@@ -113,7 +119,7 @@ def integrate_velocities(
                     e_loc += abs(fl * w[i]) * dt
                 wold = w[i]
                 wnew = (wold * (1.0 - ha) + dt * tl * m.block_inv_inertia[b, i]) / (1.0 + ha)
-                wai = 0.5 * (wold + wnew)
+                wai = w_old * wold + w_new * wnew
                 w[i] = wnew
                 e_mp += alpha * inert[i] * wai * wai * dt
                 ke += 0.5 * inert[i] * wai * wai
@@ -126,7 +132,7 @@ def integrate_velocities(
         else:
             k = m.block_motion[b]
             if k >= 0:
-                interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * dt, vd)
+                interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * step, vd)
             else:
                 vd[:] = 0.0
             if frame >= 0:
@@ -283,6 +289,13 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     return STATUS_DONE
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def commensurate(dt: float, interval: float) -> float:
+    """The largest step <= dt [s] that divides the record interval [s] a whole number of times:
+    equal steps then land on every frame time."""
+    return interval / math.ceil(interval / dt - 1e-9)
+
+
 FRAME_TOL = 1e-6
 """A step this close (in steps) to a frame's time records that frame (round-off of the landing)."""
 
@@ -290,10 +303,12 @@ FRAME_TOL = 1e-6
 @njit(cache=True, _nrt=False, inline="always")
 def frame_step(t: float, dt: float, t_frame: float) -> float:
     """Length of the step from time t [s]: dt, shortened so that a step lands on the next frame time
-    ``t_frame`` and frames are recorded at exact multiples of the record interval. A remainder
-    shorter than half a step is avoided by splitting the last stretch into two equal steps, so no
-    step is shorter than dt / 2 (the variable-step leapfrog stays second order: velocities use the
-    mean of the two step lengths)."""
+    ``t_frame`` and frames are recorded at exact multiples of the record interval. The automatic
+    step divides the record interval (:func:`commensurate`), so this shortens a step only after the
+    step was lowered mid-run or for a user-given dt: a remainder shorter than half a step is then
+    avoided by splitting the last stretch into two equal steps (no step shorter than dt / 2).
+    (Shortening one step in every frame instead cost accuracy: an undamped rocking response under
+    El Centro moved by 1-2 % of its peak.)"""
     r = t_frame - t
     if 0.0 < r <= dt:
         return r
@@ -331,6 +346,7 @@ def advance(
             dt_crit, omega, _ = contact_bound(m, s, sc)
             safe = min(s.safety[0] * dt_crit, s.resolution[0] * 2.0 / omega) if omega > 0.0 else np.inf
             if safe < s.dt[0]:
+                safe = commensurate(safe, record_interval)  # frames keep landing on equal steps
                 s.dt[0] = safe
                 s.dt_min[0] = min(s.dt_min[0], safe)
         t = s.time[0]
@@ -340,8 +356,10 @@ def advance(
             now = frame
         step = frame_step(t, dt, (frame + 1 if now >= 0 else frame) * record_interval)
         h = 0.5 * (s.dt_prev[0] + step)
-        compute_forces(m, s, sc, t, s.dt_prev[0])
-        integrate_velocities(m, s, sc, t, h, rec, now)
+        # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + step/2]
+        # (t itself unless a step was shortened to land on a frame).
+        compute_forces(m, s, sc, t + 0.25 * (step - s.dt_prev[0]), s.dt_prev[0])
+        integrate_velocities(m, s, sc, t, h, rec, now, step)
         dashpot_work(m, s, sc, h)
         integrate_positions(m, s, step)
         s.dt_prev[0] = step
