@@ -29,9 +29,9 @@ import pandas as pd
 
 from ..studies import RunSpec, Store, execute
 
-__all__ = ["Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
+__all__ = ["record_duration", "Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
 
-STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16")
+STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16", "rattling", "parapet", "facade", "two_block_wall")
 """Modules of :mod:`rockdem.reproduce` that register studies (imported on first use)."""
 
 DEFAULT_OUT = Path("docs") / "reproduction"
@@ -81,6 +81,14 @@ class Context:
         if bad:
             raise RuntimeError(f"{name}: {len(bad)} run(s) failed, e.g. {bad[0].get('error')} (inputs {_inputs(bad[0])})")
         return rows
+
+
+def record_duration(name: str) -> float:
+    """Duration [s] of the ground-motion record ``name`` (a shipped record or a path)."""
+    from ..records import read_record, record_path, shipped_record
+
+    shipped = shipped_record(name)
+    return float(read_record(record_path(name), units=shipped.units if shipped is not None else None).duration)
 
 
 def _inputs(row: Mapping[str, Any]) -> dict[str, Any]:
