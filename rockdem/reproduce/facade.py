@@ -44,7 +44,7 @@ from ..plots import STYLE, save_figure
 from ..studies import RunSpec
 from . import Context, Report, _markdown_table, paper, record_duration, reproduction
 
-__all__ = ["facade_case", "outward_peaks", "FacadeRun", "free_runs", "discretised_runs", "earthquake_runs"]
+__all__ = ["facade_case", "outward_peaks", "quake_table", "FacadeRun", "free_runs", "discretised_runs", "earthquake_runs"]
 
 TITLE = "§4.2, Figs. 12-15: the one-sided façade, SP beta and MP alpha in free rocking, discretised, under three Irpinia records"
 B, H, L = paper.FACADE_BLOCK
@@ -61,6 +61,7 @@ QUAKE_TAIL = 3.0  # s
 ETA_BASE = math.atan2(0.5 * B - paper.FACADE_EDGE_RADIUS, 0.5 * H)
 """Instability angle about the rounded edge's end [rad]: a run that ends beyond it has overturned."""
 PEAK_FRACTION = 0.05  # outward excursions below this fraction of the release rotation are not counted
+AT_WALL = 1e-3  # |theta| below this fraction of the largest rotation is "at the wall" (an impact)
 FULL = {"free": 5.0, "discretised": 5.0}
 REDUCED = {"free": 1.5, "discretised": 0.3}
 REDUCED_FREE = ((0.0, paper.FACADE_BETA), (0.0, 0.004), (1.0, 0.0))  # (alpha, beta)
@@ -89,11 +90,12 @@ def facade_case(*, alpha: float = 0.0, beta: float = 0.0, slope_deg: float = 0.0
 def outward_peaks(t: NDArray[np.float64], theta: NDArray[np.float64], side: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Peaks of the outward excursions of one-sided rocking: (times [s], side x theta at the peaks).
 
-    An excursion runs between two returns to theta = 0 (the impacts on the base and return walls);
-    ``side`` is the sign of the outward rotation. Excursions below :data:`PEAK_FRACTION` of the
+    An excursion runs between two returns to theta = 0 (the impacts on the base and return walls;
+    within :data:`AT_WALL` of the largest rotation counts as 0); ``side`` is the sign of the outward
+    rotation. Excursions below :data:`PEAK_FRACTION` of the
     first peak are dropped (the wall's rattling against the returns)."""
     x = side * np.asarray(theta, dtype=float)
-    out = x > 0.0
+    out = x > AT_WALL * float(np.max(x)) if len(x) else np.zeros(0, dtype=bool)
     edges = np.flatnonzero(np.diff(out.astype(int)) != 0) + 1
     bounds = np.r_[0, edges, len(x)]
     times, peaks = [], []
@@ -227,7 +229,9 @@ def _paper_free(r: FacadeRun) -> str:
     return "low damping insufficient"
 
 
-def _quake_table(quake: Sequence[FacadeRun]) -> tuple[pd.DataFrame, pd.DataFrame]:
+def quake_table(quake: Sequence[FacadeRun]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Per run under a record (peak, residual top displacement, overturned ...) and per record the
+    spread of the peak top displacement (max - min over mean) over the alpha and the beta variations."""
     rows = []
     for r in quake:
         t, th, u = r.history()
@@ -383,6 +387,6 @@ def facade(ctx: Context) -> Report:
         s["paper"] = _paper_free(r)
         rows.append(s)
     ft = pd.DataFrame(rows)
-    qt, spread = _quake_table(quake)
+    qt, spread = quake_table(quake)
     save_figure(_figure(free, disc, quake), ctx.out / "facade.png")
     return Report("facade", TITLE, ft, ["facade.png"], _comment(ft, spread), notes=_notes(qt, spread, ctx.reduced))
