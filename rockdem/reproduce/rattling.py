@@ -366,11 +366,14 @@ def _comment(df: pd.DataFrame) -> str:
     for _, r in sp.iterrows():
         base = r["case"].removesuffix(", SP")
         if base in get.index:
+            w1 = 2.0 * math.pi * r["chain fundamental [Hz]"]
+            xi1 = 0.5 * r["beta [s]"] * w1
             lines.append(
                 f"SP damping at the advisor's beta = {r['beta [s]'] * 1e3:.2f} ms ({base}): amplitude over the second half of the run "
-                f"{_fmt(r['vertical amplitude [mm]'])} mm against {_fmt(get.loc[base, 'vertical amplitude [mm]'])} mm undamped; the "
-                "chain model with C = beta K gives the same: the rattling modes (beta omega / 2 >> 1) are over-damped and the column "
-                "creeps into its static settlement without oscillating."
+                f"{_fmt(r['vertical amplitude [mm]'])} mm against {_fmt(get.loc[base, 'vertical amplitude [mm]'])} mm undamped, as the "
+                f"chain model with C = beta K gives ({_fmt(r['chain model amplitude [mm]'])} mm): the fundamental rattling mode gets a "
+                f"damping ratio beta omega / 2 = {xi1:.2f} and dies out within about {1e3 * 3.0 / (xi1 * w1):.0f} ms, the higher ones are "
+                "over-damped, and the column settles into its static position."
             )
     return " ".join(lines)
 
