@@ -106,6 +106,8 @@ class Report:
         figures: figure files written into the output folder (names relative to it).
         comment: short honest discussion of the differences (Markdown).
         runtime_s: wall time of the reproduction [s] (set by :func:`run_reproduction`).
+        load: 1-minute load average of the machine at the start and at the end of the run (set by
+            :func:`run_reproduction`; a shared machine's load lengthens the runtime).
         notes: extra Markdown sections (e.g. a second table), appended after the comment.
     """
 
@@ -115,6 +117,7 @@ class Report:
     figures: list[str] = field(default_factory=list)
     comment: str = ""
     runtime_s: float = 0.0
+    load: tuple[float, float] | None = None
     notes: str = ""
 
 
@@ -191,7 +194,9 @@ def write_report(report: Report, ctx: Context) -> list[Path]:
         f"Written by `rockdem reproduce {report.name}{' --reduced' if ctx.reduced else ''}` ({version}), rockdem {__version__}, "
         f"on {_dt.date.today().isoformat()}: **{report.runtime_s:.0f} s** wall time on {_machine()}"
         f" (executor {ctx.executor}{'' if ctx.workers is None else f', {ctx.workers} workers'}); "
-        f"{ctx.computed} runs computed, {ctx.reused} reused from the study stores.",
+        f"{ctx.computed} runs computed, {ctx.reused} reused from the study stores."
+        + (f" Machine load (1-minute load average): {report.load[0]:.1f} at the start, {report.load[1]:.1f} at the end."
+           if report.load is not None else ""),
         "",
     ]
     lines += [f"![{f}]({f})" for f in report.figures]
@@ -219,15 +224,26 @@ def write_index(ctx: Context) -> Path:
     return p
 
 
+def _load() -> float | None:
+    """1-minute load average, or None where the system does not give it."""
+    try:
+        return float(os.getloadavg()[0])
+    except (AttributeError, OSError):
+        return None
+
+
 def run_reproduction(name: str, ctx: Context) -> Report:
     """Run the study ``name`` and write its report; returns the report (with ``runtime_s``)."""
     _load_studies()
     if name not in REPRODUCTIONS:
         raise ValueError(f"unknown study {name!r}; studies are {sorted(REPRODUCTIONS)} (or 'all')")
     t0 = time.perf_counter()
+    load0 = _load()
     ctx.computed = ctx.reused = 0
     report = REPRODUCTIONS[name].run(ctx)
     report.runtime_s = time.perf_counter() - t0
+    load1 = _load()
+    report.load = (load0, load1) if load0 is not None and load1 is not None else None
     write_report(report, ctx)
     return report
 
