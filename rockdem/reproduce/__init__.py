@@ -29,7 +29,7 @@ import pandas as pd
 
 from ..studies import RunSpec, Store, execute
 
-__all__ = ["record_duration", "Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
+__all__ = ["energy_share", "record_duration", "Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
 
 STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16", "rattling", "parapet", "facade", "two_block_wall")
 """Modules of :mod:`rockdem.reproduce` that register studies (imported on first use)."""
@@ -89,6 +89,15 @@ def record_duration(name: str) -> float:
 
     shipped = shipped_record(name)
     return float(read_record(record_path(name), units=shipped.units if shipped is not None else None).duration)
+
+
+def energy_share(row: Mapping[str, Any]) -> float:
+    """Energy the engine created in a run over the run's energy scale (the study row's energy check,
+    :func:`rockdem.results.energy_check`); NaN for a row stored before rows carried it."""
+    created, scale = row.get("energy_created_J"), row.get("energy_scale_J")
+    if created is None or scale is None:
+        return float("nan")
+    return float(created) / max(float(scale), 1e-300)
 
 
 def _inputs(row: Mapping[str, Any]) -> dict[str, Any]:

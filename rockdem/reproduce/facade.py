@@ -42,7 +42,7 @@ from ..analysis import apparent_restitution, wme
 from ..housner import HousnerBlock, rock
 from ..plots import STYLE, save_figure
 from ..studies import RunSpec
-from . import Context, Report, _markdown_table, paper, record_duration, reproduction
+from . import Context, Report, _markdown_table, energy_share, paper, record_duration, reproduction
 
 __all__ = ["facade_case", "outward_peaks", "quake_table", "FacadeRun", "free_runs", "discretised_runs", "earthquake_runs"]
 
@@ -219,7 +219,7 @@ def _free_summary(r: FacadeRun) -> dict[str, Any]:
         "max inward rotation / (gap / H)": float(np.max(-side * th)) / (paper.FACADE_GAP / H),
         "failed sub-contacts [%]": 100.0 * (r.row["failed_shear_fraction"] + r.row["failed_tension_fraction"]),
         "residual top displacement [mm]": 1e3 * float(u[-1]),
-        "energy created / scale": r.row["energy_created_J"] / max(r.row["energy_scale_J"], 1e-300),
+        "energy created / scale": energy_share(r.row),
         "status": _status(r.row),
         "runtime [s]": r.row["runtime_s"],
     }
@@ -254,7 +254,7 @@ def quake_table(quake: Sequence[FacadeRun]) -> tuple[pd.DataFrame, pd.DataFrame]
                      "peak rotation / eta (1: overturned)": 1.0 if over else min(1.0, float(np.max(np.abs(th))) / ETA_BASE),
                      "overturned": over, "residual top displacement [mm]": 1e3 * float(u[-1]),
                      "status": _status(r.row),
-                     "energy created / scale": r.row["energy_created_J"] / max(r.row["energy_scale_J"], 1e-300),
+                     "energy created / scale": energy_share(r.row),
                      "runtime [s]": r.row["runtime_s"]})
     df = pd.DataFrame(rows)
     key = "peak rotation / eta (1: overturned)"

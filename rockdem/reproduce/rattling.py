@@ -246,7 +246,7 @@ def _summary(r: Rattle) -> dict[str, Any]:
         "failed tension [%]": 100.0 * row["failed_tension_fraction"],
         "failed shear [%]": 100.0 * row["failed_shear_fraction"],
         "top drift at the end [mm]": 1e3 * float(math.hypot(u[-1, 0], u[-1, 1])),
-        "energy created [J]": row["energy_created_J"], "energy scale [J]": row["energy_scale_J"],
+        "energy created [J]": row.get("energy_created_J", float("nan")), "energy scale [J]": row.get("energy_scale_J", float("nan")),
         "duration [s]": float(t[-1]),
         "diverged": row.get("status") == "diverged",
         "runtime [s]": row["runtime_s"],

@@ -37,7 +37,7 @@ from ..advisor import advise
 from ..analysis import half_cycle_peaks, wme
 from ..plots import STYLE, save_figure
 from ..studies import RunSpec
-from . import Context, Report, _markdown_table, paper, record_duration, reproduction
+from . import Context, Report, _markdown_table, energy_share, paper, record_duration, reproduction
 
 __all__ = ["wall_case", "formula_beta", "WallRun", "free_runs", "earthquake_runs", "release_time"]
 
@@ -169,7 +169,7 @@ def _free_summary(r: WallRun, ref: WallRun | None) -> dict[str, Any]:
         "mean peak ratio": float(np.mean(decay)) if len(decay) else float("nan"),
         "residual d [mm]": 1e3 * float(d[-1]),
         "WME vs SP beta = 0.0032": w,
-        "energy created / scale": r.row["energy_created_J"] / max(r.row["energy_scale_J"], 1e-300),
+        "energy created / scale": energy_share(r.row),
         "runtime [s]": r.row["runtime_s"],
     }
 
@@ -193,7 +193,7 @@ def _quake_summary(runs: Sequence[WallRun]) -> pd.DataFrame:
                      "residual d [mm]": 1e3 * float(d[-1]), "went beyond |d| = B": bool(np.max(np.abs(d)) > B),
                      "collapsed (ends beyond B)": bool(abs(d[-1]) > B),
                      "WME vs SP beta = 0.0032": 0.0 if ref is r else w,
-                     "energy created / scale": r.row["energy_created_J"] / max(r.row["energy_scale_J"], 1e-300),
+                     "energy created / scale": energy_share(r.row),
                      "runtime [s]": r.row["runtime_s"]})
     return pd.DataFrame(rows)
 
