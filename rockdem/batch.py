@@ -30,8 +30,8 @@ import numpy as np
 
 from .analysis import eta_of, lowest_vertex_height, summarize
 from .case import Case, CaseTemplate, template_key
-from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION
-from .results import block_eta, damping_attrs, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
+from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION, E_POTENTIAL, ENERGY_NAMES
+from .results import block_eta, damping_attrs, energy_check, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
 
 __all__ = ["Frames", "frames_from_dataset", "frames_from_run", "summary_row", "run_batch", "batch_row", "case_of", "TEMPLATE_CACHE"]
 
@@ -55,6 +55,8 @@ class Frames(NamedTuple):
         block_free: (nb,) bool.
         block_eta: (nb,) instability angle of each free block [rad] (NaN for driven ones).
         vertex_local: (nv, 3) vertices in the body frames [m]; block_vertex_start: (nb+1,).
+        energy: (T, len(ENERGY_NAMES)) recorded energies [J], columns as ``ENERGY_NAMES``, the
+            potential energy counted from the first frame (as the Dataset stores it).
         attrs: the result's attributes (steps, dt, runtime_s, diverged..., stop_reason..., the loading's).
     """
 
@@ -69,6 +71,7 @@ class Frames(NamedTuple):
     block_eta: np.ndarray
     vertex_local: np.ndarray
     block_vertex_start: np.ndarray
+    energy: np.ndarray
     attrs: Mapping[str, Any]
 
 
@@ -79,7 +82,8 @@ def frames_from_dataset(ds: Any) -> Frames:
         ds.block_quaternion.values, ds.monitor_displacement.values, int(ds.contacts_failed_shear.values[-1]),
         int(ds.contacts_failed_tension.values[-1]), np.asarray(ds.block_free.values, dtype=bool),
         ds.block_eta.values if "block_eta" in ds else np.full(ds.sizes["block"], np.nan),
-        ds.vertex_local.values, ds.block_vertex_start.values, dict(ds.attrs),
+        ds.vertex_local.values, ds.block_vertex_start.values,
+        np.stack([np.asarray(ds[n].values, dtype=float) for n in ENERGY_NAMES], axis=1), dict(ds.attrs),
     )
 
 
@@ -92,10 +96,13 @@ def frames_from_run(case: Case, out: Any) -> Frames:
     mon = monitor_displacements(model, rel_ref, rec.position, out.monitors) - u_ground[:, None]
     m = model.arrays
     attrs = {**out.attrs, **damping_attrs(model), "point_count": model.point_count, **case.attrs}
+    energy = np.array(rec.energy, dtype=float)
+    if len(energy):
+        energy[:, E_POTENTIAL] -= energy[0, E_POTENTIAL]  # as build_dataset stores it
     return Frames(
         rec.time, rocking_angles(model, rotvec), rec.position, rec.quaternion, mon, int(rec.counts[-1, COUNT_FAILED_SHEAR]),
         int(rec.counts[-1, COUNT_FAILED_TENSION]), np.asarray(m.block_free, dtype=bool), block_eta(model),
-        m.vertex_local, m.block_vertex_start, attrs,
+        m.vertex_local, m.block_vertex_start, energy, attrs,
     )
 
 
@@ -145,6 +152,10 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     row["bounce_max_m_s"] = float(s["bounce_max_m_s"]) if "bounce_max_m_s" in s else None
     row["failed_shear_fraction"] = f.failed_shear / npts
     row["failed_tension_fraction"] = f.failed_tension / npts
+    check = energy_check(f.energy)
+    row["energy_created_J"] = check.created
+    row["energy_error_J"] = check.balance_error
+    row["energy_scale_J"] = check.scale
     row["steps"] = int(a["steps"])
     row["dt"] = float(a["dt"])
     row["dt_min"] = float(a["dt_min"])
@@ -162,13 +173,15 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
 
 
 def _history(spec: Any, t: np.ndarray, theta: np.ndarray, monitor: np.ndarray, attrs: Mapping[str, Any]) -> dict[str, Any]:
-    """Decimated history (time, rotation, first monitor's x displacement). A run stopped at rest
-    is continued at rest to its duration (same interval), so that it compares with full runs."""
+    """Decimated history (time, rotation, first monitor's x displacement; with ``spec.history_xyz``
+    every monitor's three components as ``monitor_xyz``). A run stopped at rest is continued at
+    rest to its duration (same interval), so that it compares with full runs."""
     step = 1
     if spec.history_interval and len(t) > 1:
         step = max(1, int(round(spec.history_interval / (t[1] - t[0]))))
     tt, rot = t[::step], theta[::step]
     disp = monitor[::step, 0, 0].astype(float) if monitor.shape[1] else None
+    xyz = monitor[::step].astype(float) if getattr(spec, "history_xyz", False) else None
     if attrs.get("stop_reason") == "rest" and len(t) > 1:
         h = step * float(attrs["record_interval"])
         n = int(np.floor((float(attrs["duration"]) - tt[-1]) / h + 1e-9))
@@ -177,9 +190,13 @@ def _history(spec: Any, t: np.ndarray, theta: np.ndarray, monitor: np.ndarray, a
             rot = np.concatenate([rot, np.full(n, theta[-1])])
             if disp is not None:
                 disp = np.concatenate([disp, np.full(n, float(monitor[-1, 0, 0]))])
+            if xyz is not None:
+                xyz = np.concatenate([xyz, np.repeat(monitor[-1:].astype(float), n, axis=0)])
     hist: dict[str, Any] = {"time": tt.tolist(), "rotation": rot.tolist()}
     if disp is not None:
         hist["displacement"] = disp.tolist()
+    if xyz is not None:
+        hist["monitor_xyz"] = xyz.tolist()
     return hist
 
 

@@ -58,11 +58,27 @@ import xarray as xr
 if TYPE_CHECKING:
     import pandas as pd
 
-from .kernels.layout import COUNT_NAMES, E_POTENTIAL, ENERGY_NAMES, Records
+from .kernels.layout import (
+    COUNT_NAMES,
+    E_DAMPING_MASS,
+    E_DAMPING_STIFFNESS,
+    E_BOND,
+    E_ELASTIC,
+    E_FRICTION,
+    E_KINETIC,
+    E_LOCAL_DAMPING,
+    E_POTENTIAL,
+    ENERGY_NAMES,
+    W_BODY,
+    W_DRIVEN,
+    Records,
+)
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 
 __all__ = [
+    "EnergyCheck",
+    "energy_check",
     "build_dataset",
     "damping_attrs",
     "block_eta",
@@ -89,6 +105,39 @@ _DISSIPATED = (
     "energy_bond",
     "energy_local_damping",
 )
+
+
+class EnergyCheck(NamedTuple):
+    """Energy checks of a run [J].
+
+    Attributes:
+        created: the largest rise of the mechanical energy (kinetic + potential + elastic) beyond the
+            work done on the model since any earlier frame: energy the engine created (0 for a sound run:
+            dissipation only ever lowers it).
+        balance_error: mechanical + dissipated energy - work at the last frame, less its initial value:
+            positive when energy was created or a dissipation term was booked in excess.
+        scale: the run's energy scale, the largest kinetic + elastic + |potential| + dissipated +
+            |work| reached (as ``energy_balance_error_relative`` divides by).
+    """
+
+    created: float
+    balance_error: float
+    scale: float
+
+
+def energy_check(energy: np.ndarray) -> EnergyCheck:
+    """:class:`EnergyCheck` of recorded energies ``energy`` (T, len(ENERGY_NAMES)) [J], columns in the
+    order of :data:`ENERGY_NAMES` (``Records.energy``)."""
+    e = np.asarray(energy, dtype=float)
+    if len(e) == 0:
+        return EnergyCheck(0.0, 0.0, 0.0)
+    work = e[:, W_DRIVEN] + e[:, W_BODY]
+    net = e[:, E_KINETIC] + e[:, E_POTENTIAL] + e[:, E_ELASTIC] - work
+    created = float(np.max(net - np.minimum.accumulate(net)))
+    lost = sum(e[:, k] for k in (E_DAMPING_MASS, E_DAMPING_STIFFNESS, E_FRICTION, E_BOND, E_LOCAL_DAMPING))
+    total = net + lost
+    scale = e[:, E_KINETIC] + e[:, E_ELASTIC] + np.abs(e[:, E_POTENTIAL] - e[0, E_POTENTIAL]) + lost + np.abs(work)
+    return EnergyCheck(created, float(total[-1] - total[0]), float(np.max(scale)))
 
 
 def build_dataset(

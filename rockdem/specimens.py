@@ -441,6 +441,8 @@ def facade(
     points: tuple[int, int] | None = None,
     rocking_velocity: float = 0.0,
     foundation_extent: float | None = None,
+    brick: tuple[float, float] | None = None,
+    bond: str = "running",
 ) -> Monitors:
     """A façade rocking one-sidedly against return walls (Sorrentino et al., Shawa et al.; paper §4.2).
 
@@ -476,6 +478,13 @@ def facade(
         points: interface points per face; default the builder's.
         rocking_velocity: initial rocking rate [rad/s] about the bottom edge: positive towards
             the return walls (about the inner edge), negative outward (about the outer edge).
+        brick: None for the single block ``"facade"``; or (ly length, lz height) [m] of bricks, one
+            through the thickness, to discretise the façade brick by brick (paper Fig. 12A; sizes
+            adjusted to whole bricks and courses, names and groups of :func:`brick_wall`, group
+            ``"brick"``). ``material`` is then every joint's (bed, head and base; kn = E / course
+            height), and the bricks start at rest: ``edge_radius`` and ``rocking_velocity`` apply
+            to the single block only.
+        bond: ``"running"`` or ``"stack"`` (discretised façade).
 
     Returns:
         Monitors ``top`` (centre of the outer (-x) top edge), ``top_left`` and ``top_right``.
@@ -500,6 +509,17 @@ def facade(
     real_number(rocking_velocity, "rocking_velocity [rad/s]")
     material = _material("material", material)
     return_material = _material("return_material", return_material)
+    if brick is not None:
+        try:
+            by, bz = (float(v) for v in brick)
+        except (TypeError, ValueError):
+            raise ValueError(f"brick must be (length along y, height) [m] or None, got {brick!r}") from None
+        _positive("brick[0] (length, y)", by)
+        _positive("brick[1] (height, z)", bz)
+        if r > 0 or rocking_velocity != 0.0:
+            raise ValueError("edge_radius and rocking_velocity apply to the single-block façade; give 0 with brick")
+        if bond not in BONDS:
+            raise ValueError(f"bond must be one of {list(BONDS)}, got {bond!r}")
     phi = math.radians(slope_deg)
     # inner top edge after the lean (rotation about y by -phi moves the top towards -x)
     rot = axis_angle_matrix(np.array([0.0, 1.0, 0.0]), -phi)
@@ -512,7 +532,20 @@ def facade(
     fid = add_foundation(builder, collapse_extent(b + g + lr, ln, h) if foundation_extent is None else foundation_extent)
     groups = [("facade", "foundation"), ("facade", "facade"), ("foundation", "foundation"), ("return", "return"), ("return", "foundation")]
     _set_pairs(builder, groups, material)
-    _set_pairs(builder, [("facade", "return")], return_material if return_material is not None else material)
+    _set_pairs(builder, [("facade", "return"), ("brick", "return")], return_material if return_material is not None else material)
+    top = lambda y: tuple(float(v) for v in rot @ np.array([-0.5 * b, y, h]))  # noqa: E731
+    if brick is not None:
+        nb, nc = max(1, round(ln / by)), max(1, round(h / bz))
+        before = set(builder.block_names())
+        walls = brick_wall(builder, brick=(b, ln / nb, h / nc), courses=nc, bricks_per_course=nb, bond=bond, joint=material,
+                           base=material, density=density, points=points or (2, 3), foundation=False)
+        if phi != 0.0:
+            builder.transform_block(fid, rot)
+            for nm in builder.block_names():
+                if nm not in before:
+                    builder.transform_block(nm, rot)
+        _add_return_walls(builder, b=b, ln=ln, tr=tr, lr=lr, hr=hr, gap=g, density=density, points=points)
+        return {k: (walls[k][0], top(walls[k][1][1])) for k in ("top", "top_left", "top_right")}
     poly = rounded_prism(b, ln, h, radius=r, facets=edge_facets, name="facade")
     # initial rocking about the bottom edge: v_c = omega x (c - pivot)
     omega = np.array([0.0, rocking_velocity, 0.0])
@@ -526,7 +559,14 @@ def facade(
     if phi != 0.0:
         builder.transform_block(fid, rot)
         builder.transform_block("facade", rot)
-    x0 = 0.5 * b + g
+    _add_return_walls(builder, b=b, ln=ln, tr=tr, lr=lr, hr=hr, gap=g, density=density, points=points)
+    return {"top": ("facade", top(0.0)), "top_left": ("facade", top(-0.5 * ln)), "top_right": ("facade", top(0.5 * ln))}
+
+
+def _add_return_walls(builder: ModelBuilder, *, b: float, ln: float, tr: float, lr: float, hr: float, gap: float, density: float,
+                      points: tuple[int, int] | None) -> None:
+    """The two ground-driven return walls of :func:`facade`, ``gap`` behind the façade's inner face."""
+    x0 = 0.5 * b + gap
     for nm, y0 in (("return_left", -0.5 * ln), ("return_right", 0.5 * ln - tr)):
         builder.add_block(
             box(lr, tr, hr, center=(x0 + 0.5 * lr, y0 + 0.5 * tr, 0.5 * hr), name=nm),
@@ -536,8 +576,6 @@ def facade(
             driven=GROUND,
             points=points,
         )
-    top = lambda y: tuple(float(v) for v in rot @ np.array([-0.5 * b, y, h]))  # noqa: E731
-    return {"top": ("facade", top(0.0)), "top_left": ("facade", top(-0.5 * ln)), "top_right": ("facade", top(0.5 * ln))}
 
 
 # -- vertically spanning two-block wall -------------------------------------------------------------
@@ -748,10 +786,14 @@ def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
 def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
     """One-sided façade. Keys: width, height, length, return_thickness, return_length,
     return_height, gap, edge_radius [m], edge_facets, slope_deg, rocking_velocity [rad/s],
-    density, points_across, points_along, the joint keys (kn = E / height) and optional
-    [return] (façade-return wall contact)."""
+    density, brick = [ly, lz] (absent: single block "facade"), bond, points_across, points_along,
+    the joint keys (kn = E / height, or E / course height when discretised) and optional [return]
+    (façade-return wall contact)."""
     height = t.number("height", 0.8, positive=True)
-    mat = joint_material(t, spacing=height)
+    brick = tuple(float(v) for v in t.vector("brick", size=2)) if "brick" in t.data else None
+    t.used.add("brick")
+    spacing = height if brick is None else height / max(1, round(height / brick[1]))
+    mat = joint_material(t, spacing=spacing)
     rh = t.optional_number("return_height", positive=True)
     return facade(
         b,
@@ -767,9 +809,11 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
         edge_facets=t.integer("edge_facets", 4, min_=1, max_=MAX_EDGE_FACETS),
         slope_deg=t.number("slope_deg", 0.0),
         material=mat,
-        return_material=_sub_material(t, "return", spacing=height),
-        points=t.points(),
+        return_material=_sub_material(t, "return", spacing=spacing),
+        points=t.points(2, 3 if brick is not None else 2),
         rocking_velocity=t.number("rocking_velocity", 0.0),
+        brick=brick,  # type: ignore[arg-type]
+        bond=t.string("bond", "running", choices=BONDS),
     )
 
 

@@ -102,6 +102,8 @@ class RunSpec:
         pga_g: target peak ground acceleration of the record [g] (None: record unscaled).
         history: keep a decimated history (time, rotation, monitor displacement) in the row.
         history_interval: decimation of the history [s] (None: the case's record interval).
+        history_xyz: the history also keeps every monitor's three displacement components
+            (``monitor_xyz``, (T, monitors, 3) [m]; vertical rattling, torsion, out-of-plane drift).
     """
 
     base: Mapping[str, Any]
@@ -111,6 +113,7 @@ class RunSpec:
     pga_g: float | None = None
     history: bool = False
     history_interval: float | None = None
+    history_xyz: bool = False
 
     @classmethod
     def make(cls, base: Mapping[str, Any], overrides: Mapping[str, Any] | None = None, **kwargs: Any) -> "RunSpec":
@@ -139,6 +142,8 @@ class RunSpec:
             "history": self.history,
             "history_interval": self.history_interval,
         }
+        if self.history_xyz:  # only when set: specs without it keep the ids they had before it existed
+            out["history_xyz"] = True
         if self.record is not None:
             out["record_sha1"] = _file_sha1(self.record)
         return out
@@ -230,7 +235,9 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     ``stop_time_s`` and ``stop_block``; ``max_rotation_rad``, ``max_rotation_over_eta``,
     ``overturned``, ``residual_rad``, ``residual_disp_m`` / ``max_disp_m`` (first monitor,
     horizontal), ``e_a_mean``, ``bounce_max_m_s``, ``failed_shear_fraction``,
-    ``failed_tension_fraction``, ``steps``, ``dt`` (the starting timestep), ``dt_min`` (the
+    ``failed_tension_fraction``, ``energy_created_J`` (the largest rise of the mechanical energy beyond
+    the work done: energy the engine created), ``energy_error_J`` (energy-balance error at the end) and
+    ``energy_scale_J`` (the run's energy scale; :func:`rockdem.results.energy_check`), ``steps``, ``dt`` (the starting timestep), ``dt_min`` (the
     smallest, after any lowering at contact detections), ``runtime_s`` (engine loop), ``kernel_s``
     (inside the compiled kernel), ``wall_s`` (whole run), ``cpu_s`` (its processor time), and
     ``history`` when asked for; with ``damping.beta = "auto"`` or ``"critical"`` also ``beta_s``,
@@ -549,7 +556,8 @@ def save_table(df: pd.DataFrame, folder: str | os.PathLike[str], name: str = "ta
 
 
 def histories(rows: Store | Iterable[Mapping[str, Any]]) -> dict[str, dict[str, np.ndarray]]:
-    """Decimated histories by run id: {"time", "rotation", "displacement"} arrays."""
+    """Decimated histories by run id: {"time", "rotation", "displacement"} arrays (and
+    "monitor_xyz", (T, monitors, 3), for specs with ``history_xyz``)."""
     data = rows.rows() if isinstance(rows, Store) else list(rows)
     return {r["id"]: {k: np.asarray(v, dtype=float) for k, v in r["history"].items()} for r in data if r.get("history")}
 

@@ -128,3 +128,39 @@ def test_save_replaces_a_symlink_instead_of_writing_through_it(tmp_path):
     assert load(link).sizes["time"] == ds.sizes["time"]
     with pytest.raises(ValueError, match="is a folder"):
         save(ds, tmp_path)
+
+
+def test_energy_check_closed_forms():
+    """energy_check on synthetic energies: an exchange between kinetic and potential energy creates
+    nothing; a dissipated joule booked as friction keeps the balance; a bump of 5 J is 5 J created."""
+    from rockdem.kernels.layout import E_ELASTIC, E_FRICTION, E_KINETIC, E_POTENTIAL, ENERGY_NAMES, W_DRIVEN
+    from rockdem.results import energy_check
+
+    n = 200
+    t = np.linspace(0.0, 1.0, n)
+    e = np.zeros((n, len(ENERGY_NAMES)))
+    e[:, E_KINETIC] = 10.0 * np.sin(2 * np.pi * t) ** 2
+    e[:, E_POTENTIAL] = -10.0 * np.sin(2 * np.pi * t) ** 2 - 1.0 * t  # 1 J lost over the run ...
+    e[:, E_FRICTION] = 1.0 * t  # ... to friction
+    chk = energy_check(e)
+    assert chk.created == pytest.approx(0.0, abs=1e-12)
+    assert chk.balance_error == pytest.approx(0.0, abs=1e-12)
+    assert chk.scale == pytest.approx(np.max(20.0 * np.sin(2 * np.pi * t) ** 2 + 2.0 * t), rel=1e-12)  # kinetic + |potential| + lost
+    e[n // 2 :, E_ELASTIC] += 5.0  # energy from nowhere
+    chk = energy_check(e)
+    assert chk.created == pytest.approx(5.0 - 1.0 / (n - 1), rel=1e-9)  # the rise less one sample's friction loss
+    assert chk.balance_error == pytest.approx(5.0, rel=1e-9)
+    e[n // 2 :, W_DRIVEN] += 5.0  # ... unless a driven block did that work
+    assert energy_check(e).created == pytest.approx(0.0, abs=1e-9)
+
+
+def test_summary_rows_carry_the_energy_check():
+    """A damped free-rocking block creates no energy: the row's check is near zero, its balance
+    error small against its energy scale."""
+    from rockdem.case import example_case
+    from rockdem.studies import RunSpec, run_spec
+
+    row = run_spec(RunSpec.make(example_case("free-rocking"), duration=1.5))
+    assert row["energy_scale_J"] > 0.0
+    assert 0.0 <= row["energy_created_J"] < 1e-3 * row["energy_scale_J"]
+    assert abs(row["energy_error_J"]) < 0.01 * row["energy_scale_J"]

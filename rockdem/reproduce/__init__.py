@@ -29,9 +29,9 @@ import pandas as pd
 
 from ..studies import RunSpec, Store, execute
 
-__all__ = ["Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
+__all__ = ["energy_share", "record_duration", "Context", "Report", "Reproduction", "REPRODUCTIONS", "reproduction", "run_reproduction", "write_report", "register_cli"]
 
-STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16", "damping")
+STUDY_MODULES = ("fig4", "table1", "fig8", "table2", "fig5_7", "fig16", "damping", "rattling", "parapet", "facade", "two_block_wall")
 """Modules of :mod:`rockdem.reproduce` that register studies (imported on first use)."""
 
 DEFAULT_OUT = Path("docs") / "reproduction"
@@ -83,6 +83,23 @@ class Context:
         return rows
 
 
+def record_duration(name: str) -> float:
+    """Duration [s] of the ground-motion record ``name`` (a shipped record or a path)."""
+    from ..records import read_record, record_path, shipped_record
+
+    shipped = shipped_record(name)
+    return float(read_record(record_path(name), units=shipped.units if shipped is not None else None).duration)
+
+
+def energy_share(row: Mapping[str, Any]) -> float:
+    """Energy the engine created in a run over the run's energy scale (the study row's energy check,
+    :func:`rockdem.results.energy_check`); NaN for a row stored before rows carried it."""
+    created, scale = row.get("energy_created_J"), row.get("energy_scale_J")
+    if created is None or scale is None:
+        return float("nan")
+    return float(created) / max(float(scale), 1e-300)
+
+
 def _inputs(row: Mapping[str, Any]) -> dict[str, Any]:
     skip = {"id", "status", "error", "history"}
     return {k: v for k, v in row.items() if k not in skip}
@@ -98,6 +115,8 @@ class Report:
         figures: figure files written into the output folder (names relative to it).
         comment: short honest discussion of the differences (Markdown).
         runtime_s: wall time of the reproduction [s] (set by :func:`run_reproduction`).
+        load: 1-minute load average of the machine at the start and at the end of the run (set by
+            :func:`run_reproduction`; a shared machine's load lengthens the runtime).
         notes: extra Markdown sections (e.g. a second table), appended after the comment.
     """
 
@@ -107,6 +126,7 @@ class Report:
     figures: list[str] = field(default_factory=list)
     comment: str = ""
     runtime_s: float = 0.0
+    load: tuple[float, float] | None = None
     notes: str = ""
 
 
@@ -183,7 +203,9 @@ def write_report(report: Report, ctx: Context) -> list[Path]:
         f"Written by `rockdem reproduce {report.name}{' --reduced' if ctx.reduced else ''}` ({version}), rockdem {__version__}, "
         f"on {_dt.date.today().isoformat()}: **{report.runtime_s:.0f} s** wall time on {_machine()}"
         f" (executor {ctx.executor}{'' if ctx.workers is None else f', {ctx.workers} workers'}); "
-        f"{ctx.computed} runs computed, {ctx.reused} reused from the study stores.",
+        f"{ctx.computed} runs computed, {ctx.reused} reused from the study stores."
+        + (f" Machine load (1-minute load average): {report.load[0]:.1f} at the start, {report.load[1]:.1f} at the end."
+           if report.load is not None else ""),
         "",
     ]
     lines += [f"![{f}]({f})" for f in report.figures]
@@ -211,15 +233,26 @@ def write_index(ctx: Context) -> Path:
     return p
 
 
+def _load() -> float | None:
+    """1-minute load average, or None where the system does not give it."""
+    try:
+        return float(os.getloadavg()[0])
+    except (AttributeError, OSError):
+        return None
+
+
 def run_reproduction(name: str, ctx: Context) -> Report:
     """Run the study ``name`` and write its report; returns the report (with ``runtime_s``)."""
     _load_studies()
     if name not in REPRODUCTIONS:
         raise ValueError(f"unknown study {name!r}; studies are {sorted(REPRODUCTIONS)} (or 'all')")
     t0 = time.perf_counter()
+    load0 = _load()
     ctx.computed = ctx.reused = 0
     report = REPRODUCTIONS[name].run(ctx)
     report.runtime_s = time.perf_counter() - t0
+    load1 = _load()
+    report.load = (load0, load1) if load0 is not None and load1 is not None else None
     write_report(report, ctx)
     return report
 

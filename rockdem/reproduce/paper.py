@@ -63,3 +63,58 @@ TABLE2_E = 1800e6
 TABLE2_BETA = 0.00693
 TABLE2_POINTS = (2, 3, 4, 5, 10, 15)
 TABLE2_HOURS = (6.0, 13.0, 16.0, 20.0, 34.0, 54.0)
+
+# §2.1 / Fig. 1: rattling. Free vibration under gravity of blocks L 370 x W 250 x H 120 mm on a fixed
+# block, E = 1800 MPa, joints c = 1.4 MPa, ft = 0.84 MPa, mu = 0.7. Amplitudes as printed [m].
+RATTLING_BLOCK = (0.37, 0.25, 0.12)  # (L along the wall, W thickness, H) [m]
+RATTLING_E = 1800e6  # Pa, kn = E / block height
+RATTLING_DENSITY = 1800.0  # kg/m^3 (not stated in §2.1; the paper's value elsewhere)
+RATTLING_COHESION = 1.4e6  # Pa
+RATTLING_TENSION = 0.84e6  # Pa
+RATTLING_FRICTION = 0.7  # mu
+RATTLING_FREQUENCY_RANGE = (300.0, 1600.0)  # Hz, columns of two and seven blocks
+RATTLING_VERTICAL = {2: 2e-7, 7: 22e-7}  # m: vertical amplitude of the two- and seven-block columns
+RATTLING_HORIZONTAL_COLUMN = 1e-20  # m (1e-17 mm): horizontal rattling of the columns (Fig. 1A-C)
+RATTLING_WALL_OUT_OF_PLANE = 4e-6  # m (4e-3 mm): seven-course wall with head joints, paper's y (out of plane)
+RATTLING_WALL_VERTICAL = 1e-6  # m (1e-3 mm): the same wall, z
+RATTLING_WALL_HEIGHTS = (0.84, 3.00)  # m
+RATTLING_BASE_FAILURE_DRIFT = 14e-6  # m (14e-3 mm): drift after the base joint failed in tension
+RATTLING_COHESIONLESS_BASE = 3e-7  # m (3e-4 mm): seven-block wall, cohesionless base, vertical
+RATTLING_COHESIVE_BASE = 4e-6  # m (4e-3 mm): the same wall with the cohesive base, as quoted beside it
+
+# §4.1 / Figs. 10-11: Giaretton et al. parapet, 230 mm thick with 7 mm removed at the base, E = 1800 MPa,
+# 1800 kg/m^3; discretised joints c, ft [Pa] with mu = 0.6 and the failed sub-contact shares [%].
+PARAPET_THICKNESS = 0.23  # m
+PARAPET_BASE_REDUCTION = 0.007  # m
+PARAPET_E = 1800e6  # Pa
+PARAPET_FRICTION = 0.6
+PARAPET_DISCRETISED = {(0.5e6, 0.1e6): (35.0, 55.0), (0.6e6, 0.5e6): (18.0, 19.0)}  # (c, ft): (shear %, tension %)
+PARAPET_BASE_TENSION = (0.06e6, 0.07e6, 0.10e6)  # Pa: SP best fit, mortar tests, MP best fit
+PARAPET_BASE_TENSION_MORTAR = 0.07e6  # Pa (Giaretton et al. mortar samples)
+PARAPET_BASE_TENSION_BEST = {"MP": 0.10e6, "SP": 0.06e6}  # Pa
+
+# §4.2 / Figs. 12-15: one-sided façade of Sorrentino et al. / Shawa et al.
+FACADE_BLOCK = (0.11, 0.8, 1.5)  # B, H, L [m]
+FACADE_DENSITY = 1750.0  # kg/m^3
+FACADE_E = 1800e6  # Pa
+FACADE_FRICTION = 0.6
+FACADE_GAP = 0.004  # m
+FACADE_EDGE_RADIUS = 0.008  # m
+FACADE_BETAS = (0.000125, 0.00025, 0.0005, 0.001, 0.002, 0.004, 0.0058)  # s, free rocking (§4.2)
+FACADE_BETAS_UNDERDAMPED = (0.000125, 0.00025, 0.0005, 0.001)  # late motion left undamped
+FACADE_BETAS_OVERDAMPED = (0.002, 0.004, 0.0058)  # "overdamped after the first impact"
+FACADE_BETA_FORMULA = {"one-sided": 0.00017, "two-sided": 0.00470}  # s (§4.2)
+FACADE_E_FACTOR_DISCRETISED = 1e-2  # E x 1e-2 brought the discretised model closer to the test
+FACADE_DISCRETISED_TOP_DRIFT = 0.004  # m: residual rotational displacement at the top (Fig. 12B)
+FACADE_RECORDS = {"bagnoli": 0.191, "sturno": 0.210, "calitri": 0.348}  # shipped record: slope phi [deg]
+FACADE_MISSING_RECORD = ("R1168EW", 0.272)  # record name and slope [deg] of Fig. 14C/15C: not available
+
+# §4.4 / Figs. 17-18: Griffith et al. two-block wall
+TWO_BLOCK_WALL = (0.11, 1.5, 0.95)  # B, H, L [m]
+TWO_BLOCK_DENSITY = 1800.0  # kg/m^3
+TWO_BLOCK_E = 48e6  # Pa (Godio and Beyer)
+TWO_BLOCK_FRICTION = 0.7
+TWO_BLOCK_ALPHA = 0.7539  # 1/s, MP (minimum WME)
+TWO_BLOCK_BETA = 0.0032  # s, SP: the §2.2 formula (with E = 1800 MPa, see the study)
+TWO_BLOCK_BETA_GODIO = 0.0038  # s, Godio and Beyer
+TWO_BLOCK_RECORDS = (("elcentro-rsn6", 0.66), ("pacoima", 0.80), ("nahanni", 1.00))  # record, scale
