@@ -33,7 +33,7 @@ import signal
 import threading
 import time as _time
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
@@ -42,7 +42,7 @@ import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
-from .kernels.step import DIVERGENCE_ERROR, advance, commensurate, frame_step
+from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
 from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
@@ -86,15 +86,13 @@ def simulate(
         duration: simulated time at the end of the run [s] (continuing a checkpoint: the end time,
             not the time added).
         dt: timestep [s]; default automatic (see :mod:`rockdem.timestep`); refused above the bound.
-            Either is rounded down to divide the record interval (frames land on equal steps);
-            ``attrs["dt"]`` is the step used.
         timestep_rule: "bound" (default) or "3dec" (0.2 sqrt(m_min/k_max)).
         safety: fraction of the stable bound for the automatic timestep (default 0.9).
         resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
             keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
-        record_interval: time between recorded frames [s] (default 0.002). The step divides it,
-            so frame k is recorded at k record_interval (to round-off); when the step is lowered
-            during the run, the step that would pass the next frame is shortened to land on it.
+        record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
+            the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
+            within half a step of it.
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
             configuration (before any initial tilt); displacements are measured from there.
@@ -382,14 +380,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         ck.check_model(model)
         state, scratch = ck.engine_arrays(model)
         scratch.lost_block[:] = -1
-    # The step divides the record interval, so that equal steps land on every frame
-    # (kernels.step.commensurate; a user's dt too, rounded down at most by a factor n / (n + 1)
-    # for n steps per frame, and reported as attrs["dt"]).
-    step0 = commensurate(info.dt, interval)
-    info = replace(info, dt=step0)
-    state.dt[0] = state.dt_min[0] = step0
-    # The initial velocity is that of the half step before t = 0, a step as long as the first one.
-    state.dt_prev[0] = frame_step(0.0, step0, interval)
+    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     m = model.arrays

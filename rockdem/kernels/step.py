@@ -289,34 +289,6 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     return STATUS_DONE
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def commensurate(dt: float, interval: float) -> float:
-    """The largest step <= dt [s] that divides the record interval [s] a whole number of times:
-    equal steps then land on every frame time."""
-    return interval / math.ceil(interval / dt - 1e-9)
-
-
-FRAME_TOL = 1e-6
-"""A step this close (in steps) to a frame's time records that frame (round-off of the landing)."""
-
-
-@njit(cache=True, _nrt=False, inline="always")
-def frame_step(t: float, dt: float, t_frame: float) -> float:
-    """Length of the step from time t [s]: dt, shortened so that a step lands on the next frame time
-    ``t_frame`` and frames are recorded at exact multiples of the record interval. The automatic
-    step divides the record interval (:func:`commensurate`), so this shortens a step only after the
-    step was lowered mid-run or for a user-given dt: a remainder shorter than half a step is then
-    avoided by splitting the last stretch into two equal steps (no step shorter than dt / 2).
-    (Shortening one step in every frame instead cost accuracy: an undamped rocking response under
-    El Centro moved by 1-2 % of its peak.)"""
-    r = t_frame - t
-    if 0.0 < r <= dt:
-        return r
-    if dt < r < 1.5 * dt:
-        return 0.5 * r
-    return dt
-
-
 @njit(cache=True, _nrt=False)
 def advance(
     m: ModelArrays, s: State, sc: Scratch, t_stop: float, record_interval: float, rec: Records, frame: int
@@ -328,8 +300,8 @@ def advance(
     recording the first bad frame (see :func:`check_frame`). After each detection the bound of the
     tracked contacts is recomputed and dt is lowered (never raised) to (2 / omega_max)
     min(safety f_SP, resolution) (:mod:`rockdem.timestep`), so that contacts stiffer than those at
-    the start (a toppling block landing on a side face) stay stable and resolved. Steps land on the
-    frame times (:func:`frame_step`); velocities use the mean of the two step lengths.
+    the start (a toppling block landing on a side face) stay stable and resolved. Velocities use
+    the mean of the two step lengths.
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
@@ -346,18 +318,17 @@ def advance(
             dt_crit, omega, _ = contact_bound(m, s, sc)
             safe = min(s.safety[0] * dt_crit, s.resolution[0] * 2.0 / omega) if omega > 0.0 else np.inf
             if safe < s.dt[0]:
-                safe = commensurate(safe, record_interval)  # frames keep landing on equal steps
                 s.dt[0] = safe
                 s.dt_min[0] = min(s.dt_min[0], safe)
         t = s.time[0]
         dt = s.dt[0]
         now = -1
-        if frame < rec.time.shape[0] and t >= frame * record_interval - FRAME_TOL * dt:
-            now = frame
-        step = frame_step(t, dt, (frame + 1 if now >= 0 else frame) * record_interval)
+        if frame < rec.time.shape[0] and t >= frame * record_interval - 0.5 * dt:
+            now = frame  # the step nearest to the frame's time
+        step = dt
         h = 0.5 * (s.dt_prev[0] + step)
         # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + step/2]
-        # (t itself unless a step was shortened to land on a frame).
+        # (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.25 * (step - s.dt_prev[0]), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, now, step)
         dashpot_work(m, s, sc, h)
