@@ -203,14 +203,16 @@ def _start(data: Mapping[str, Any], case: Case) -> Any:
     from .simulation import prepare_start
 
     r = case.run
-    key = json.dumps([template_key(data), case.model.damping.__dict__, r.timestep_rule, r.safety, r.resolution, r.dt],
+    key = json.dumps([template_key(data), case.model.damping.__dict__, r.timestep_rule, r.safety, r.resolution, r.dt,
+                      r.dashpots],
                      sort_keys=True, default=str)
     with _LOCK:
         start = _STARTS.get(key)
         if start is not None:
             _STARTS.move_to_end(key)
     if start is None:
-        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution, dt=r.dt)
+        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution,
+                              dt=r.dt, dashpots=r.dashpots)
         with _LOCK:
             _STARTS[key] = start
             while len(_STARTS) > TEMPLATE_CACHE:
