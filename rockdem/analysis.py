@@ -37,6 +37,7 @@ __all__ = [
     "max_rotation",
     "residual_drift",
     "overturned",
+    "first_impact_time",
     "rocking_onset_time",
     "summarize",
     "lowest_point_height",
@@ -397,6 +398,30 @@ def rocking_onset_time(t: ArrayLike, theta: ArrayLike, threshold: float) -> floa
         raise ValueError(f"rocking_onset_time: threshold must be > 0 rad, got {threshold!r}")
     above = np.flatnonzero(np.abs(th) > threshold)
     return float(t[above[0]]) if len(above) else None
+
+
+def first_impact_time(t: ArrayLike, theta: ArrayLike, threshold: float | None = None) -> float | None:
+    """Time of the first impact [s]: the first zero crossing of the rotation after it first exceeds
+    ``threshold`` (a block released from a tilt, or rocking under an input), linearly interpolated
+    between samples; None if it never crosses.
+
+    Args:
+        t: (n,) time [s].
+        theta: (n,) rotation [rad].
+        threshold: rotation that counts as rocking [rad]; default 1 % of max |theta|.
+    """
+    t, th = _history(t, theta, "first_impact_time")
+    thr = 0.01 * float(np.abs(th).max()) if threshold is None else float(threshold)
+    above = np.flatnonzero(np.abs(th) > thr)
+    if not len(above):
+        return None
+    i0 = above[0]
+    sign = np.sign(th[i0])
+    cross = np.flatnonzero(np.sign(th[i0:]) == -sign)
+    if not len(cross):
+        return None
+    i = i0 + cross[0]
+    return float(t[i - 1] + (t[i] - t[i - 1]) * th[i - 1] / (th[i - 1] - th[i]))
 
 
 SUMMARY_PEAK_PROMINENCE = 0.02

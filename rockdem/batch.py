@@ -228,13 +228,14 @@ def _start(data: Mapping[str, Any], case: Case) -> Any:
 
     r = case.run
     key = json.dumps([template_key(data), case.model.damping.__dict__, case.model.arrays.mat_beta.tolist(), r.timestep_rule,
-                      r.safety, r.resolution, r.dt], sort_keys=True, default=str)
+                      r.safety, r.resolution, r.dt, r.dashpots], sort_keys=True, default=str)
     with _LOCK:
         start = _STARTS.get(key)
         if start is not None:
             _STARTS.move_to_end(key)
     if start is None:
-        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution, dt=r.dt)
+        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution,
+                              dt=r.dt, dashpots=r.dashpots)
         with _LOCK:
             _STARTS[key] = start
             while len(_STARTS) > TEMPLATE_CACHE:

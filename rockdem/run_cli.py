@@ -56,7 +56,7 @@ def run_options(case: Case, duration: float | None = None) -> dict[str, Any]:
     if r.record_interval > dur:
         raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
     return {"duration": dur, "dt": r.dt, "timestep_rule": r.timestep_rule, "safety": r.safety, "resolution": r.resolution,
-            "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
+            "dashpots": r.dashpots, "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
             "stop": r.stop}
 
 

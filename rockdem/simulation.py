@@ -48,7 +48,15 @@ from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
 from .state import grow_buffers, initial_state
 from .stopping import Decision, Stopper, StopRule, stop_rule
-from .timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, TimestepInfo, stable_timestep
+from .timestep import (
+    DEFAULT_RESOLUTION,
+    DEFAULT_SAFETY,
+    MAX_DAMPING_RATIO,
+    TimestepInfo,
+    dashpot_code,
+    resolve_dashpots,
+    stable_timestep,
+)
 
 __all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
 
@@ -69,6 +77,7 @@ def simulate(
     timestep_rule: str | None = None,
     safety: float | None = None,
     resolution: float | None = None,
+    dashpots: str | None = None,
     record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
@@ -90,6 +99,10 @@ def simulate(
         safety: fraction of the stable bound for the automatic timestep (default 0.9).
         resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
             keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
+        dashpots: how SP dashpots are integrated: "implicit" (trapezoidal, stable at the undamped
+            step whatever beta, :mod:`rockdem.kernels.implicit`), "explicit" (on the last half step's
+            velocities with Belytschko's step reduction, as 3DEC does) or "auto" (default, None:
+            implicit, explicit with local damping); see ``docs/dashpots.md``.
         record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
             the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
             within half a step of it.
@@ -126,7 +139,7 @@ def simulate(
             a checkpoint of another model.
     """
     out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
-                    record_interval=record_interval, monitors=monitors, progress=progress,
+                    dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
                     contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
                     checkpoint=checkpoint, checkpoint_every=checkpoint_every)
     ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
@@ -152,9 +165,9 @@ class Start(NamedTuple):
 
 
 def prepare_start(model: Model, *, timestep_rule: str = "bound", safety: float = DEFAULT_SAFETY,
-                  resolution: float = DEFAULT_RESOLUTION, dt: float | None = None) -> Start:
+                  resolution: float = DEFAULT_RESOLUTION, dt: float | None = None, dashpots: str | None = None) -> Start:
     """The :class:`Start` of a run of ``model`` with these timestep options."""
-    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt)
+    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt, dashpots=dashpots)
     return Start(info, *initial_state(model))
 
 
@@ -177,6 +190,7 @@ def run_model(
     timestep_rule: str | None = None,
     safety: float | None = None,
     resolution: float | None = None,
+    dashpots: str | None = None,
     record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
     progress: bool | None = None,
@@ -211,10 +225,10 @@ def run_model(
     ck = None if initial is None else load_checkpoint(initial)
     wall0 = _time.perf_counter()
     if ck is None or ck.fresh:
-        run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+        run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
                          contact_interval, max_steps, start)
     else:
-        run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, record_interval,
+        run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
                              contact_interval, max_steps)
     saver = _Saver(model, run, checkpoint, checkpoint_every)
     info, state, scratch, rec, snaps = run.info, run.state, run.scratch, run.records, run.snaps
@@ -286,6 +300,10 @@ def run_model(
         "sp_factor": info.sp_factor,
         "resolution": info.resolution,
         "timestep_rule": info.rule,
+        "dashpots": info.dashpots,
+        "damping_ratio": info.damping_ratio,
+        "dashpot_sweeps": int(state.dashpot_sweeps[0]),
+        "dashpot_unconverged_steps": int(state.dashpot_unconverged[0]),
         "steps": int(state.step[0]),
         "runtime_s": runtime,
         "kernel_s": kernel,
@@ -358,7 +376,7 @@ def _frames(model: Model, duration: float, record_interval: float) -> Records:
 
 
 def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float | None, rule: str | None,
-               safety: float | None, resolution: float | None, record_interval: float | None,
+               safety: float | None, resolution: float | None, dashpots: str | None, record_interval: float | None,
                contact_interval: float | None, max_steps: int, start: Start | None = None) -> _Run:
     """A run from t = 0: the model's initial state (``start``'s when given: its timestep and
     arrays, used in place), or a checkpoint's state with its clock reset."""
@@ -368,8 +386,11 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     snaps = ContactSnapshots(model, contact_interval)
     if start is not None:
         info = start.timestep
+        if dashpots is not None and resolve_dashpots(model, dashpots) != info.dashpots:
+            raise ValueError(f"dashpots = {dashpots!r} differs from the prepared start's ({info.dashpots!r})")
     else:
-        info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt)
+        info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
+                               dashpots=dashpots)
     _check_step_count(info, duration, max_steps)
     rec = _frames(model, duration, interval)
     if start is not None:
@@ -383,6 +404,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
+    state.dashpots[0] = dashpot_code(info.dashpots)
     m = model.arrays
     scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
     snaps.take(state)
@@ -390,14 +412,15 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
 
 
 def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | None, rule: str | None,
-                   safety: float | None, resolution: float | None, record_interval: float | None,
-                   contact_interval: float | None, max_steps: int) -> _Run:
+                   safety: float | None, resolution: float | None, dashpots: str | None,
+                   record_interval: float | None, contact_interval: float | None, max_steps: int) -> _Run:
     """The run saved in ``ck``, continued to ``duration``: its state, frames and snapshots."""
     ck.check_model(model)
     given = {"dt": (dt, ck.timestep.dt if ck.timestep.rule == "user" else None),
              "timestep_rule": (rule, ck.timestep.rule if ck.timestep.rule != "user" else None),
              "safety": (safety, float(ck.state.safety[0])),
              "resolution": (resolution, float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
+             "dashpots": (None if dashpots is None else resolve_dashpots(model, dashpots), ck.timestep.dashpots),
              "record_interval": (record_interval, ck.record_interval),
              "contact_interval": (contact_interval, ck.contact_interval)}
     for name, (value, saved) in given.items():
@@ -524,6 +547,13 @@ def _check_step_count(info: TimestepInfo, duration: float, max_steps: int) -> No
         raise ValueError(
             f"the timestep {info.dt:.3g} s is longer than the run ({duration:.3g} s): the contacts are implausibly "
             f"soft or the blocks implausibly heavy {where}"
+        )
+    if info.damping_ratio > MAX_DAMPING_RATIO:
+        explicit = duration / info.dt * (math.hypot(1.0, info.damping_ratio) + info.damping_ratio)
+        raise ValueError(
+            f"SP damping ratio beta omega_max / 2 = {info.damping_ratio:.3g} at the highest contact frequency is "
+            f"implausibly high (limit {MAX_DAMPING_RATIO:g}; explicit dashpots would need about {explicit:.3g} steps) "
+            f"{where}"
         )
     steps = duration / info.dt
     if steps > max_steps:

@@ -32,10 +32,50 @@ import numpy as np
 
 from .kernels.bound import contact_bound
 from .kernels.contact import sp_critical_factor
+from .kernels.layout import DASHPOTS_EXPLICIT, DASHPOTS_IMPLICIT
 from .model import Model
 from .state import initial_state
 
-__all__ = ["TimestepInfo", "stable_timestep", "DEFAULT_SAFETY", "DEFAULT_RESOLUTION"]
+__all__ = ["TimestepInfo", "stable_timestep", "DEFAULT_SAFETY", "DEFAULT_RESOLUTION", "DASHPOT_SCHEMES",
+           "resolve_dashpots", "dashpot_code", "MAX_DAMPING_RATIO"]
+
+DASHPOT_SCHEMES = ("auto", "implicit", "explicit")
+"""How SP dashpots are integrated: "implicit" (trapezoidal, stable at the undamped step,
+:mod:`rockdem.kernels.implicit`), "explicit" (on the last half step's velocities with Belytschko's
+step reduction, as 3DEC) or "auto" (the default: implicit, but explicit for a model with local
+damping, whose force -alpha_L |F| sign(v) needs the whole unbalanced force before the velocity update)."""
+
+MAX_DAMPING_RATIO = 1e6
+"""Largest damping ratio beta omega_max / 2 at the highest contact frequency that a run accepts
+(implicit dashpots are stable for any; this refuses a beta given in the wrong unit)."""
+
+
+def resolve_dashpots(model: Model, dashpots: str | None) -> str:
+    """The scheme ("implicit" or "explicit") a run of ``model`` uses for ``dashpots`` (None: "auto").
+
+    Raises:
+        ValueError: not one of :data:`DASHPOT_SCHEMES`, or "implicit" with local damping.
+    """
+    dashpots = "auto" if dashpots is None else dashpots
+    if dashpots not in DASHPOT_SCHEMES:
+        raise ValueError(f"dashpots must be 'auto', 'implicit' or 'explicit', got {dashpots!r}")
+    local = model.arrays.local_damping > 0.0
+    if dashpots == "implicit" and local:
+        raise ValueError(
+            "dashpots = 'implicit' cannot be combined with local damping (damping.local > 0): its force "
+            "-alpha_L |F| sign(v) needs the whole unbalanced force, dashpots included, before the velocity "
+            "update; use dashpots = 'explicit' (or 'auto', which does so for local damping)"
+        )
+    if dashpots == "auto":
+        return "explicit" if local else "implicit"
+    return dashpots
+
+
+def dashpot_code(dashpots: str) -> int:
+    """The kernel code (``State.dashpots``) of a resolved scheme, "implicit" or "explicit"."""
+    if dashpots not in ("implicit", "explicit"):
+        raise ValueError(f"dashpots must be 'implicit' or 'explicit' here, got {dashpots!r}")
+    return DASHPOTS_IMPLICIT if dashpots == "implicit" else DASHPOTS_EXPLICIT
 
 DEFAULT_SAFETY = 0.9
 """Fraction of the critical (stability) step used by default."""
@@ -52,9 +92,12 @@ class TimestepInfo:
         dt: the initial timestep [s].
         critical: the stable bound (safety 1) at the start [s]; a user dt above it is refused.
         omega_max: bound of the highest circular frequency [rad/s].
-        sp_factor: reduction sqrt(1+xi^2) - xi for SP damping (1 without).
+        sp_factor: reduction sqrt(1+xi^2) - xi for SP damping (1 without, and with implicit dashpots).
         rule: "bound", "3dec" or "user".
         resolution: the impact-resolution fraction of 2 / omega_max used (rule "bound").
+        dashpots: the scheme used, "implicit" or "explicit" (:func:`resolve_dashpots`).
+        damping_ratio: beta omega_max / 2, the SP damping ratio at omega_max (largest beta of the
+            limiting block; 0 without SP damping).
     """
 
     dt: float
@@ -63,9 +106,11 @@ class TimestepInfo:
     sp_factor: float
     rule: str
     resolution: float = DEFAULT_RESOLUTION
+    dashpots: str = "explicit"  # checkpoints written before the implicit scheme existed
+    damping_ratio: float = 0.0
 
 
-def _all_faces_bound(model: Model) -> tuple[float, float, float]:
+def _all_faces_bound(model: Model, sp_reduction: bool) -> tuple[float, float, float]:
     """Critical step if every interface point of every free block touched a fixed partner."""
     m = model.arrays
     groups = np.unique(m.block_group)
@@ -86,7 +131,7 @@ def _all_faces_bound(model: Model) -> tuple[float, float, float]:
             return 1.0 / m.block_mass[b] + (np.cross(r, d) ** 2) @ (1.0 / m.block_inertia[b])
 
         w = math.sqrt(coupling * float(np.sum(area * (kn * flex(n) + ks * (flex(t1) + flex(t2))))))
-        f = sp_critical_factor(beta, w)
+        f = sp_critical_factor(beta, w) if sp_reduction else 1.0
         if 2.0 / w * f < best[0]:
             best = (2.0 / w * f, w, f)
     return best
@@ -99,6 +144,7 @@ def stable_timestep(
     safety: float = DEFAULT_SAFETY,
     resolution: float = DEFAULT_RESOLUTION,
     dt: float | None = None,
+    dashpots: str | None = None,
 ) -> TimestepInfo:
     """Timestep for ``model`` at its initial state.
 
@@ -108,10 +154,14 @@ def stable_timestep(
         resolution: largest omega_max dt / 2 (impact resolution, see the module notes); 1 turns
             the accuracy limit off.
         dt: a user timestep [s]; refused if above the stable bound.
+        dashpots: "auto" (default, None), "implicit" or "explicit" SP dashpots
+            (:data:`DASHPOT_SCHEMES`): only explicit ones reduce the stable step by Belytschko's factor.
 
     Raises:
-        ValueError: unknown rule, bad safety, or a user dt above the stable bound.
+        ValueError: unknown rule or dashpot scheme, bad safety, or a user dt above the stable bound.
     """
+    dashpots = resolve_dashpots(model, dashpots)
+    explicit = dashpots == "explicit"
     if rule not in ("bound", "3dec"):
         raise ValueError(f"timestep rule must be 'bound' or '3dec', got {rule!r}")
     if not (math.isfinite(safety) and 0.0 < safety <= 1.0):
@@ -119,10 +169,11 @@ def stable_timestep(
     if not (math.isfinite(resolution) and 0.0 < resolution <= 1.0):
         raise ValueError(f"timestep resolution must lie in (0, 1], got {resolution!r}")
     s, sc = initial_state(model)
-    critical, om, fac = (float(v) for v in contact_bound(model.arrays, s, sc))
-    free_fall = _all_faces_bound(model)
+    critical, om, fac = (float(v) for v in contact_bound(model.arrays, s, sc, explicit))
+    free_fall = _all_faces_bound(model, explicit)
     if not math.isfinite(critical):
         critical, om, fac = free_fall
+    xi = 0.5 * float(np.max(model.arrays.mat_beta)) * om
     if dt is not None:
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be a positive time step [s], got {dt!r}")
@@ -132,14 +183,14 @@ def stable_timestep(
                 f"(omega_max = {om:.4g} rad/s, SP reduction {fac:.4f}); use dt <= {critical:.3e} s "
                 "or leave dt unset for the automatic value"
             )
-        return TimestepInfo(float(dt), critical, om, fac, "user")
+        return TimestepInfo(float(dt), critical, om, fac, "user", dashpots=dashpots, damping_ratio=xi)
     if rule == "3dec":
         m = model.arrays
         free = m.block_free
         m_min = float(np.min(m.block_mass[free]))
         k_max = float(np.max(m.mat_kn)) * float(np.max(m.point_area[free[m.point_block]]))
         w = math.sqrt(k_max / m_min)
-        f3 = sp_critical_factor(float(np.max(m.mat_beta)), w)
-        return TimestepInfo(0.2 * math.sqrt(m_min / k_max) * f3, critical, om, f3, "3dec")
+        f3 = sp_critical_factor(float(np.max(m.mat_beta)), w) if explicit else 1.0
+        return TimestepInfo(0.2 * math.sqrt(m_min / k_max) * f3, critical, om, f3, "3dec", dashpots=dashpots, damping_ratio=xi)
     accurate = resolution * 2.0 / om if om > 0.0 else math.inf
-    return TimestepInfo(min(safety * critical, accurate), critical, om, fac, "bound", resolution)
+    return TimestepInfo(min(safety * critical, accurate), critical, om, fac, "bound", resolution, dashpots, xi)

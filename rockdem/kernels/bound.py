@@ -79,11 +79,13 @@ def _contact_rows(
 
 
 @njit(cache=True, _nrt=False)
-def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, float]:
+def contact_bound(m: ModelArrays, s: State, sc: Scratch, sp_reduction: bool) -> tuple[float, float, float]:
     """Critical timestep of the tracked contacts (safety 1).
 
     Returns (dt_critical [s], omega_max [rad/s], SP factor) of the limiting block; dt_critical is
-    +inf when no block has a contact.
+    +inf when no block has a contact. ``sp_reduction``: explicit dashpots, whose critical step is
+    reduced by Belytschko's factor; implicit dashpots (:mod:`rockdem.kernels.implicit`) are stable
+    at the undamped step 2 / omega (factor 1).
     """
     nb = m.block_mass.shape[0]
     row = sc.bound_stiffness
@@ -143,7 +145,7 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, float, 
         if not m.block_free[b] or row[b] <= 0.0:
             continue
         w = math.sqrt(row[b])
-        f = sp_critical_factor(beta[b], w)
+        f = sp_critical_factor(beta[b], w) if sp_reduction else 1.0
         dtb = 2.0 / w * f
         if dtb < dt_crit:
             dt_crit, omega, factor = dtb, w, f

@@ -91,6 +91,22 @@ def ramp_overlap(un: float, un_prev: float, vn: float, dt: float) -> float:
     return un
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def dashpot_onset_share(since: float, h: float) -> float:
+    """Share of the velocity step [t - h/2, t + h/2] (length h [s]) of a dashpot whose contact closed
+    ``since`` [s] before t, with the part the last step missed when it closed before t - h/2:
+    since / h + 1/2, at most 3/2 (implicit dashpots, :mod:`rockdem.kernels.implicit`)."""
+    return min(since / h + 0.5, 1.5)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def dashpot_release_share(un: float, vn: float, dt: float) -> float:
+    """Share of the velocity step to add, at the first step out of contact, to a dashpot whose contact
+    opened at t - s dt during the last position step dt (overlap un <= 0 now [m], separating at vn
+    > 0 [m/s]): 1/2 - s, negative when the last step applied it past the opening."""
+    return 0.5 - min(-un / (vn * dt), 1.0)
+
+
 RELEASE_INTERVALS = 8
 """Simpson intervals per segment for the impulse of a releasing shear spring (the profile is
 linear except where the Coulomb cap takes over)."""

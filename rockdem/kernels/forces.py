@@ -16,6 +16,8 @@ from numba import njit
 
 from .contact import (
     coulomb_limit,
+    dashpot_onset_share,
+    dashpot_release_share,
     drop_dissipation,
     ramp_overlap,
     release_shear,
@@ -26,6 +28,7 @@ from .contact import (
 from .blend import blend_weight, face_clearance, tracks_target
 from .faces import COVER_FULL, COVER_NONE, COVER_PART, FaceMap, covered, face_map_arrays, partly_covered
 from .layout import (
+    DASHPOTS_IMPLICIT,
     E_BOND,
     E_FRICTION,
     FAILED_SHEAR,
@@ -210,6 +213,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
     e_fric = 0.0
     e_bond = 0.0
     nrel = 0
+    implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
@@ -222,13 +226,13 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
         lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
         # The owner's points on the target face, then (while the pair may blend) the target's on
         # the owner face.
-        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel)
+        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel, implicit)
         elastic += el
         active += ac
         e_fric += ef
         e_bond += eb
         if split < stop:
-            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel)
+            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel, implicit)
             elastic += el
             active += ac
             e_fric += ef
@@ -245,11 +249,13 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
 @njit(cache=True, _nrt=False)
 def _law_range(
     m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, nrel: int,
+    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool,
 ) -> tuple[float, int, float, float, int, float]:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
-    False: the whole pair, wgt 1). Returns (elastic energy, active count, friction and bond energy
+    False: the whole pair, wgt 1). With ``implicit`` dashpots (:mod:`rockdem.kernels.implicit`) only
+    half the dashpot force at the last half step's velocity is applied here and each active
+    dashpot is stored (``sc.dashpot_*``) for the velocity solve. Returns (elastic energy, active count, friction and bond energy
     dissipated, the new opened count, the normal spring energy at full share)."""
     elastic = 0.0
     active = 0
@@ -267,6 +273,7 @@ def _law_range(
         code = s.track[k]
         p = code // SLOTS
         j = code - SLOTS * p
+        sc.dashpot_cn[k] = 0.0
         sc.dashpot_force[k, 0] = 0.0
         sc.dashpot_force[k, 1] = 0.0
         sc.dashpot_force[k, 2] = 0.0
@@ -334,7 +341,8 @@ def _law_range(
         # (a fraction of the step) and its impulse is completed (contact.ramp_overlap).
         ramp = 1.0
         since = dt
-        if not bonded and un_prev <= 0.0 and vn < 0.0:
+        closing = not bonded and un_prev <= 0.0 and vn < 0.0
+        if closing:
             since = min(un / (-vn * dt), 1.0) * dt
             ramp = ramp_overlap(un, un_prev, vn, dt) / un
         f_applied = fn * ramp
@@ -378,6 +386,21 @@ def _law_range(
         # Rayleigh SP damping follows the tangent stiffness: no shear dashpot while slipping.
         fdn = -beta * kna * vn
         bs = 0.0 if slipping else beta * ksa
+        if implicit and beta > 0.0:
+            # Implicit dashpots (kernels.implicit): half the force at the last half step's velocity
+            # now, the other half at the new velocity in the velocity solve. A contact that closed
+            # during the last step has its dashpot from the crossing on.
+            onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
+            sc.dashpot_cn[k] = onset * beta * kna
+            sc.dashpot_cs[k] = onset * bs
+            sc.dashpot_normal[k, 0] = n0
+            sc.dashpot_normal[k, 1] = n1
+            sc.dashpot_normal[k, 2] = n2
+            sc.dashpot_velocity[k, 0] = v0
+            sc.dashpot_velocity[k, 1] = v1
+            sc.dashpot_velocity[k, 2] = v2
+            fdn *= 0.5 * onset
+            bs *= 0.5 * onset
         d0 = fdn * n0 - bs * vs0
         d1 = fdn * n1 - bs * vs1
         d2 = fdn * n2 - bs * vs2
@@ -471,6 +494,23 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
             m.mat_res_tan_friction[go, gt] * kn * prev_area, un_prev, vn, v0 - vn * n0, v1 - vn * n1, v2 - vn * n2, dt,
         )
         e_fric += d
+        if s.dashpots[0] == DASHPOTS_IMPLICIT and vn > 0.0 and m.mat_beta[go, gt] > 0.0:
+            # Implicit dashpots: the dashpot acted until the opening; its share of this velocity step
+            # (negative: the last step applied it past the opening), at the last half step's velocity.
+            beta = m.mat_beta[go, gt] * dashpot_release_share(un, vn, dt) * prev_area
+            vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+            d0 = -beta * (kn * vn * n0 + ks * vs0)
+            d1 = -beta * (kn * vn * n1 + ks * vs1)
+            d2 = -beta * (kn * vn * n2 + ks * vs2)
+            sc.dashpot_force[k, 0] = d0
+            sc.dashpot_force[k, 1] = d1
+            sc.dashpot_force[k, 2] = d2
+            sc.dashpot_velocity[k, 0] = v0
+            sc.dashpot_velocity[k, 1] = v1
+            sc.dashpot_velocity[k, 2] = v2
+            c0 += d0
+            c1 += d1
+            c2 += d2
         _store(sc.contact_force, sc.contact_point, k, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
         s.slot_shear[p, j, 0] = 0.0
         s.slot_shear[p, j, 1] = 0.0
@@ -508,6 +548,7 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     ea = s.pair_edge_a[i]
     eb = s.pair_edge_b[i]
     sc.pair_dashpot_force[i, :] = 0.0
+    sc.pair_dashpot_cn[i] = 0.0
     sc.pair_force[i, :] = 0.0
     a00, a01, a02 = _world_point(m, s, sc, a, m.edge_vertex[ea, 0])
     a10, a11, a12 = _world_point(m, s, sc, a, m.edge_vertex[ea, 1])
@@ -550,6 +591,18 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
         if un_prev > 0.0:
             fnc = kna * ramp_overlap(un, un_prev, vn, dt)
             c0, c1, c2, e = release_shear(us0, us1, us2, ksa, m.mat_res_tan_friction[ga, gb] * kna, un_prev, vn, vs0, vs1, vs2, dt)
+            if s.dashpots[0] == DASHPOTS_IMPLICIT and vn > 0.0 and m.mat_beta[ga, gb] > 0.0:  # as in _release_pass
+                rel = m.mat_beta[ga, gb] * dashpot_release_share(un, vn, dt)
+                d0, d1, d2 = -rel * (kna * vn * n0 + ksa * vs0), -rel * (kna * vn * n1 + ksa * vs1), -rel * (kna * vn * n2 + ksa * vs2)
+                sc.pair_dashpot_force[i, 0] = d0
+                sc.pair_dashpot_force[i, 1] = d1
+                sc.pair_dashpot_force[i, 2] = d2
+                sc.pair_dashpot_velocity[i, 0] = v0
+                sc.pair_dashpot_velocity[i, 1] = v1
+                sc.pair_dashpot_velocity[i, 2] = v2
+                c0 += d0
+                c1 += d1
+                c2 += d2
             _store(sc.pair_force, sc.pair_point, i, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
         s.pair_shear[i, 0] = 0.0
         s.pair_shear[i, 1] = 0.0
@@ -558,7 +611,8 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
         return 0.0, 0, e
     ramp = 1.0
     since = dt
-    if un_prev <= 0.0 and vn < 0.0:
+    closing = un_prev <= 0.0 and vn < 0.0
+    if closing:
         since = min(un / (-vn * dt), 1.0) * dt
         ramp = ramp_overlap(un, un_prev, vn, dt) / un
     fn = kna * un
@@ -581,6 +635,15 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     beta = m.mat_beta[ga, gb]
     fdn = -beta * kna * vn
     bs = 0.0 if slipping else beta * ksa
+    if s.dashpots[0] == DASHPOTS_IMPLICIT and beta > 0.0:  # as in _law_range
+        onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
+        sc.pair_dashpot_cn[i] = onset * beta * kna
+        sc.pair_dashpot_cs[i] = onset * bs
+        sc.pair_dashpot_velocity[i, 0] = v0
+        sc.pair_dashpot_velocity[i, 1] = v1
+        sc.pair_dashpot_velocity[i, 2] = v2
+        fdn *= 0.5 * onset
+        bs *= 0.5 * onset
     d0, d1, d2 = fdn * n0 - bs * vs0, fdn * n1 - bs * vs1, fdn * n2 - bs * vs2
     sc.pair_dashpot_force[i, 0] = d0
     sc.pair_dashpot_force[i, 1] = d1

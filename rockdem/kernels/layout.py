@@ -30,6 +30,10 @@ PAIR_EDGE = 1
 SLOTS = 2
 """Partners a point can hold at once (a point on the shared edge of two faces of its partners)."""
 
+# How the SP dashpots are integrated (State.dashpots).
+DASHPOTS_IMPLICIT = 0  # trapezoidal in the damping: stable at the undamped step (kernels.implicit)
+DASHPOTS_EXPLICIT = 1  # on the last half step's velocities, Belytschko-reduced step (3DEC's scheme)
+
 # Status returned by the stepping loop.
 STATUS_DONE = 0
 STATUS_GROW = 1  # the pair or candidate buffers are full: enlarge them and continue
@@ -143,6 +147,9 @@ class State(NamedTuple):
     dt_min: np.ndarray  # (1,) [s] smallest step used so far
     safety: np.ndarray  # (1,) fraction of the stable bound used when the step is lowered
     resolution: np.ndarray  # (1,) largest omega_max dt / 2 when the step is lowered (impact resolution)
+    dashpots: np.ndarray  # (1,) int64 DASHPOTS_IMPLICIT or DASHPOTS_EXPLICIT
+    dashpot_sweeps: np.ndarray  # (1,) int64 Jacobi sweeps of the implicit dashpots of coupled free blocks so far
+    dashpot_unconverged: np.ndarray  # (1,) int64 steps whose sweeps stopped at DASHPOT_MAX_SWEEPS
     step: np.ndarray  # (1,) int64 steps taken
     position: np.ndarray  # (nb, 3) [m] centroid
     quaternion: np.ndarray  # (nb, 4) body -> world
@@ -203,6 +210,10 @@ class Scratch(NamedTuple):
     contact_force: np.ndarray  # (SLOTS np, 3) [N] force of each tracked sub-contact on its owner, world
     contact_point: np.ndarray  # (SLOTS np, 3) [m] its point of application, world
     dashpot_force: np.ndarray  # (SLOTS np, 3) [N] the SP dashpot part of that force
+    dashpot_cn: np.ndarray  # (SLOTS np,) [N s/m] normal dashpot beta kn A of an active sub-contact, 0 inactive
+    dashpot_cs: np.ndarray  # (SLOTS np,) [N s/m] shear dashpot beta ks A (0 while slipping)
+    dashpot_normal: np.ndarray  # (SLOTS np, 3) its unit normal, world (into the block the force acts on)
+    dashpot_velocity: np.ndarray  # (SLOTS np, 3) [m/s] relative velocity at the last half step (owner minus target)
     track_area: np.ndarray  # (SLOTS np,) [m^2] effective area of each tracked sub-contact
     track_point_u: np.ndarray  # (SLOTS np,) [m] its force point, owner face coordinate u
     track_point_w: np.ndarray  # (SLOTS np,) [m] ... and w
@@ -214,6 +225,9 @@ class Scratch(NamedTuple):
     pair_force: np.ndarray  # (P, 3) [N] EDGE pairs: force on block a
     pair_point: np.ndarray  # (P, 3) [m] its point of application
     pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: the SP dashpot part
+    pair_dashpot_cn: np.ndarray  # (P,) [N s/m] EDGE pairs: normal dashpot, 0 inactive
+    pair_dashpot_cs: np.ndarray  # (P,) [N s/m] EDGE pairs: shear dashpot
+    pair_dashpot_velocity: np.ndarray  # (P, 3) [m/s] EDGE pairs: relative velocity of a to b at the last half step
     pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
@@ -221,6 +235,15 @@ class Scratch(NamedTuple):
     blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block
     blend_point_target: np.ndarray  # (P, 3) [m] ... at this point (minus it on the owner's block)
     velocity_mid: np.ndarray  # (nb, 3) [m/s] step mid-point velocity
+    block_damping: np.ndarray  # (nb, 6, 6) implicit dashpots: sum of J^T C J over a block's dashpots, world
+    # (force, torque) x (velocity, angular velocity) [N s/m, N s, N m s]
+    block_coupling: np.ndarray  # (nb, 6) [N, N m] implicit dashpots: sum of J^T C u over its dashpots, u the
+    # partner's point velocity (world force and torque)
+    block_lhs: np.ndarray  # (nb, 6, 6) implicit dashpots: Cholesky factor of the block's velocity equations
+    block_rhs: np.ndarray  # (nb, 6) their right-hand side without the partners' coupling
+    block_iterate: np.ndarray  # (2, nb, 6) velocity (world) and angular velocity (body) iterates (Jacobi sweeps)
+    block_damped: np.ndarray  # (nb,) bool the block has an active dashpot this step
+    driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots)
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
     poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
     cand_code: np.ndarray  # (C,) int64 detection: candidate point p (slot assigned later)

@@ -24,7 +24,10 @@ from numba import njit
 from .bound import contact_bound
 from .detect import detect, update_rotations
 from .forces import compute_forces
+from .implicit import couple, factor_block, finalize, mark_damped, solve_block, sweep
 from .layout import (
+    DASHPOTS_EXPLICIT,
+    DASHPOTS_IMPLICIT,
     E_DAMPING_MASS,
     E_DAMPING_STIFFNESS,
     E_ELASTIC,
@@ -53,13 +56,47 @@ DIVERGENCE_ERROR = 0.2
 """Energy-balance error, as a fraction of the run's energy scale so far, that marks a divergence."""
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _free_energies(
+    m: ModelArrays, s: State, sc: Scratch, b: int, vg: np.ndarray, wa0: float, wa1: float, wa2: float, dt: float
+) -> tuple[float, float, float, float]:
+    """(MP dissipation over the step, work of the body loads, kinetic energy, potential energy) [J]
+    of free block b from its mid-step velocity ``sc.velocity_mid[b]`` and body-frame angular
+    velocity wa."""
+    mass = m.block_mass[b]
+    va = sc.velocity_mid[b]
+    inert = m.block_inertia[b]
+    e_mp = 0.0
+    w_body = 0.0
+    ke = 0.0
+    pe = 0.0
+    for i in range(3):
+        e_mp += m.alpha * mass * (va[i] - vg[i]) ** 2 * dt
+        w_body += mass * sc.body_acc[i] * va[i] * dt
+        ke += 0.5 * mass * va[i] * va[i]
+        pe -= mass * m.gravity[i] * s.position[b, i]
+    rot = inert[0] * wa0 * wa0 + inert[1] * wa1 * wa1 + inert[2] * wa2 * wa2
+    e_mp += m.alpha * rot * dt
+    ke += 0.5 * rot
+    r = sc.rotation[b]
+    for i in range(3):
+        sc.omega_mid[b, i] = r[i, 0] * wa0 + r[i, 1] * wa1 + r[i, 2] * wa2
+    return e_mp, w_body, ke, pe
+
+
 @njit(cache=True, _nrt=False)
 def integrate_velocities(
     m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int, step: float
 ) -> None:
-    """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` (the mean of the last and the next step)
-    ; a driven block takes its prescribed velocity at the middle of the next position step
-    ``step`` [s]; records frame ``frame`` (if >= 0) at t_n."""
+    """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` [s] (the mean of the last and the next
+    step); records frame ``frame`` (if >= 0) at t_n.
+
+    Driven blocks first take their prescribed velocity at the middle of the next position step
+    ``step`` [s]. A free block with an active
+    dashpot under implicit dashpots (``State.dashpots``) solves its 6 x 6 velocity equations
+    (:mod:`rockdem.kernels.implicit`, block-Jacobi sweeps where dashpots join free blocks); the
+    others take the explicit update with MP damping at the step mid-point.
+    """
     nb = m.block_mass.shape[0]
     alpha = m.alpha
     ha = 0.5 * alpha * dt
@@ -70,87 +107,133 @@ def integrate_velocities(
     else:
         vg[:] = 0.0
     vd = sc.driven_velocity
+    for b in range(nb):
+        if m.block_free[b]:
+            continue
+        k = m.block_motion[b]
+        if k >= 0:
+            interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * step, vd)
+        else:
+            vd[:] = 0.0
+        for i in range(3):
+            sc.driven_velocity_last[b, i] = s.velocity[b, i]
+            s.velocity[b, i] = vd[i]
+            s.omega[b, i] = 0.0
+            sc.velocity_mid[b, i] = vd[i]
+            sc.omega_mid[b, i] = 0.0
     # The velocity at t_n: the half-step velocities at t_n - dt_prev / 2 and t_n + step / 2
     # interpolated (their mean when the two steps are equal; dt is their mean).
     w_new = 1.0 - 0.5 * step / dt
     w_old = 1.0 - w_new
-    ke = 0.0
-    pe = 0.0
+    implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
+    coupled = False
+    it = sc.block_iterate[0]
+    if implicit:
+        coupled = mark_damped(m, s, sc)
+        for b in range(nb):
+            if sc.block_damped[b]:
+                for i in range(3):
+                    it[b, i] = s.velocity[b, i]
+                    it[b, 3 + i] = s.omega[b, i]
+        couple(m, s, sc, it)
     e_mp = 0.0
     e_loc = 0.0
     w_body = 0.0
-    w_drv = 0.0
-    jd = 0
+    ke = 0.0
+    pe = 0.0
     for b in range(nb):
+        if not m.block_free[b]:
+            continue
         r = sc.rotation[b]
+        damped = sc.block_damped[b]
+        mass = m.block_mass[b]
         va = sc.velocity_mid[b]
-        if m.block_free[b]:
-            mass = m.block_mass[b]
-            for i in range(3):
-                fi = sc.force[b, i]
-                if m.local_damping > 0.0 and s.velocity[b, i] != 0.0:
-                    fl = m.local_damping * abs(fi) * (1.0 if s.velocity[b, i] > 0.0 else -1.0)
-                    fi -= fl
-                    e_loc += abs(fl * s.velocity[b, i]) * dt
-                vold = s.velocity[b, i]
+        for i in range(3):
+            fi = sc.force[b, i]
+            if m.local_damping > 0.0 and s.velocity[b, i] != 0.0:
+                fl = m.local_damping * abs(fi) * (1.0 if s.velocity[b, i] > 0.0 else -1.0)
+                fi -= fl
+                e_loc += abs(fl * s.velocity[b, i]) * dt
+            vold = s.velocity[b, i]
+            if damped:
+                sc.block_rhs[b, i] = mass * (vold * (1.0 - ha) + 2.0 * ha * vg[i]) + dt * fi
+            else:
                 vnew = (vold * (1.0 - ha) + dt * fi * m.block_inv_mass[b] + 2.0 * ha * vg[i]) / (1.0 + ha)
                 va[i] = w_old * vold + w_new * vnew
                 s.velocity[b, i] = vnew
-                e_mp += alpha * mass * (va[i] - vg[i]) ** 2 * dt
-                w_body += mass * sc.body_acc[i] * va[i] * dt
-                ke += 0.5 * mass * va[i] * va[i]
-                pe -= mass * m.gravity[i] * s.position[b, i]
-            # Euler's equations in the principal body frame.
-            tq = sc.torque[b]
-            tb0 = r[0, 0] * tq[0] + r[1, 0] * tq[1] + r[2, 0] * tq[2]
-            tb1 = r[0, 1] * tq[0] + r[1, 1] * tq[1] + r[2, 1] * tq[2]
-            tb2 = r[0, 2] * tq[0] + r[1, 2] * tq[1] + r[2, 2] * tq[2]
-            w = s.omega[b]
-            inert = m.block_inertia[b]
-            g0 = w[1] * inert[2] * w[2] - w[2] * inert[1] * w[1]
-            g1 = w[2] * inert[0] * w[0] - w[0] * inert[2] * w[2]
-            g2 = w[0] * inert[1] * w[1] - w[1] * inert[0] * w[0]
-            wa0 = wa1 = wa2 = 0.0
-            for i in range(3):
-                tl = (tb0 - g0) if i == 0 else ((tb1 - g1) if i == 1 else (tb2 - g2))
-                if m.local_damping > 0.0 and w[i] != 0.0:
-                    fl = m.local_damping * abs(tl) * (1.0 if w[i] > 0.0 else -1.0)
-                    tl -= fl
-                    e_loc += abs(fl * w[i]) * dt
-                wold = w[i]
-                wnew = (wold * (1.0 - ha) + dt * tl * m.block_inv_inertia[b, i]) / (1.0 + ha)
-                wai = w_old * wold + w_new * wnew
-                w[i] = wnew
-                e_mp += alpha * inert[i] * wai * wai * dt
-                ke += 0.5 * inert[i] * wai * wai
-                if i == 0:
-                    wa0 = wai
-                elif i == 1:
-                    wa1 = wai
-                else:
-                    wa2 = wai
-        else:
-            k = m.block_motion[b]
-            if k >= 0:
-                interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * step, vd)
+        # Euler's equations in the principal body frame.
+        tq = sc.torque[b]
+        tb0 = r[0, 0] * tq[0] + r[1, 0] * tq[1] + r[2, 0] * tq[2]
+        tb1 = r[0, 1] * tq[0] + r[1, 1] * tq[1] + r[2, 1] * tq[2]
+        tb2 = r[0, 2] * tq[0] + r[1, 2] * tq[1] + r[2, 2] * tq[2]
+        w = s.omega[b]
+        inert = m.block_inertia[b]
+        g0 = w[1] * inert[2] * w[2] - w[2] * inert[1] * w[1]
+        g1 = w[2] * inert[0] * w[0] - w[0] * inert[2] * w[2]
+        g2 = w[0] * inert[1] * w[1] - w[1] * inert[0] * w[0]
+        wa0 = wa1 = wa2 = 0.0
+        for i in range(3):
+            tl = (tb0 - g0) if i == 0 else ((tb1 - g1) if i == 1 else (tb2 - g2))
+            if m.local_damping > 0.0 and w[i] != 0.0:
+                fl = m.local_damping * abs(tl) * (1.0 if w[i] > 0.0 else -1.0)
+                tl -= fl
+                e_loc += abs(fl * w[i]) * dt
+            wold = w[i]
+            if damped:
+                sc.block_rhs[b, 3 + i] = inert[i] * wold * (1.0 - ha) + dt * tl
+                continue
+            wnew = (wold * (1.0 - ha) + dt * tl * m.block_inv_inertia[b, i]) / (1.0 + ha)
+            wai = w_old * wold + w_new * wnew
+            w[i] = wnew
+            if i == 0:
+                wa0 = wai
+            elif i == 1:
+                wa1 = wai
             else:
-                vd[:] = 0.0
+                wa2 = wai
+        if damped:
+            factor_block(m, sc, b, dt, ha)
+            solve_block(sc, b, dt, it)
+            continue
+        e1, e2, e3, e4 = _free_energies(m, s, sc, b, vg, wa0, wa1, wa2, dt)
+        e_mp += e1
+        w_body += e2
+        ke += e3
+        pe += e4
+    if coupled:
+        sweep(m, s, sc, dt, dt * math.sqrt(m.gravity[0] ** 2 + m.gravity[1] ** 2 + m.gravity[2] ** 2))
+    if implicit:
+        for b in range(nb):
+            if not sc.block_damped[b]:
+                continue
+            for i in range(3):
+                sc.velocity_mid[b, i] = w_old * s.velocity[b, i] + w_new * it[b, i]
+                s.velocity[b, i] = it[b, i]
+            wa0 = w_old * s.omega[b, 0] + w_new * it[b, 3]
+            wa1 = w_old * s.omega[b, 1] + w_new * it[b, 4]
+            wa2 = w_old * s.omega[b, 2] + w_new * it[b, 5]
+            for i in range(3):
+                s.omega[b, i] = it[b, 3 + i]
+            e1, e2, e3, e4 = _free_energies(m, s, sc, b, vg, wa0, wa1, wa2, dt)
+            e_mp += e1
+            w_body += e2
+            ke += e3
+            pe += e4
+        s.energy[E_DAMPING_STIFFNESS] += finalize(m, s, sc, dt)
+    w_drv = 0.0
+    jd = 0
+    for b in range(nb):
+        if not m.block_free[b]:
             if frame >= 0:
                 for i in range(3):
                     rec.driven_reaction[frame, jd, i] = -sc.force[b, i]
             jd += 1
             for i in range(3):
-                w_drv -= sc.force[b, i] * vd[i] * dt
-                s.velocity[b, i] = vd[i]
-                s.omega[b, i] = 0.0
-                va[i] = vd[i]
-            wa0 = wa1 = wa2 = 0.0
-        for i in range(3):
-            sc.omega_mid[b, i] = r[i, 0] * wa0 + r[i, 1] * wa1 + r[i, 2] * wa2
+                w_drv -= sc.force[b, i] * s.velocity[b, i] * dt
         if frame >= 0:
             for i in range(3):
                 rec.position[frame, b, i] = s.position[b, i]
-                rec.velocity[frame, b, i] = va[i]
+                rec.velocity[frame, b, i] = sc.velocity_mid[b, i]
                 rec.omega[frame, b, i] = sc.omega_mid[b, i]
             for i in range(4):
                 rec.quaternion[frame, b, i] = s.quaternion[b, i]
@@ -315,7 +398,7 @@ def advance(
                 for b in range(m.block_mass.shape[0]):
                     s.moved[b] = m.contact_tol  # detect again once the buffers are enlarged
                 return frame, STATUS_GROW
-            dt_crit, omega, _ = contact_bound(m, s, sc)
+            dt_crit, omega, _ = contact_bound(m, s, sc, s.dashpots[0] == DASHPOTS_EXPLICIT)
             safe = min(s.safety[0] * dt_crit, s.resolution[0] * 2.0 / omega) if omega > 0.0 else np.inf
             if safe < s.dt[0]:
                 s.dt[0] = safe
@@ -331,7 +414,8 @@ def advance(
         # (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.25 * (step - s.dt_prev[0]), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, now, step)
-        dashpot_work(m, s, sc, h)
+        if s.dashpots[0] == DASHPOTS_EXPLICIT:
+            dashpot_work(m, s, sc, h)
         integrate_positions(m, s, step)
         s.dt_prev[0] = step
         s.time[0] = t + step
