@@ -101,12 +101,9 @@ def test_facade_findings(ctx: Context, facade: Report) -> None:
     _, spread = quake_table(earthquake_runs(ctx))  # the stored runs
     row = spread.set_index("record").loc["bagnoli"]
     assert row["SP beta x 0.5-2: spread"] < 0.25  # halved or doubled, beta moves the peak little
-    # MP (alpha matched to the free rocking) lets the façade rock further than SP: under Bagnoli it
-    # overturns where SP with beta halved or doubled stays standing (which alpha tips it first is
-    # chaotic: the full study reports the spread over alpha x 0.9-1.1 as a number)
-    mp = [float(v) for v in str(row["MP peaks / eta"]).split(",")]
-    sp = [float(v) for v in str(row["SP peaks / eta (x 0.5, 0.9, 1, 1.1, 2)"]).split(",")]
-    assert min(mp) > max(sp)
+    # Whether MP (alpha matched to the free rocking) lets the façade rock further than SP, and which
+    # alpha tips it, is chaotic in this engine (the full study: MP peaks above SP in some record-scale
+    # sets, below in others): reported as numbers in docs/reproduction/facade.md, not asserted.
 
 
 def test_two_block_wall(ctx: Context, wall: Report) -> None:
