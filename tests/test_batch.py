@@ -177,4 +177,6 @@ def test_automatic_beta_sweep_rows_by_both_paths(base, monkeypatch):
     assert len({(r["beta_s"], r["beta_search_time_s"]) for r in auto}) == 1  # one search, its record on every row
     assert auto[0]["beta_target_value"] == pytest.approx(housner_e_eta(np.arctan2(0.19, 0.5)))
     assert abs(auto[0]["beta_achieved_e_a"] / auto[0]["beta_target_value"] - 1) < 0.01
-    assert {r["steps"] for r in crit} != {r["steps"] for r in by[0.0005]}  # the chosen beta is the one run
+    # the chosen beta is the one run: its responses differ from beta = 0.0005's on the same inputs
+    # (implicit dashpots: the step no longer depends on beta, so the step counts may agree)
+    assert [r["max_rotation_rad"] for r in crit] != [r["max_rotation_rad"] for r in by[0.0005]]
