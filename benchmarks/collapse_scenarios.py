@@ -309,12 +309,12 @@ def energy_creation(ds: xr.Dataset) -> tuple[float, float]:
     return created, float(np.max(np.sum(parts, axis=0)))
 
 
-def evaluate(sc: Scenario, *, overlap_every: int = 1) -> tuple[Outcome, xr.Dataset]:
-    """Run a scenario and measure it."""
+def evaluate(sc: Scenario, *, overlap_every: int = 1, dashpots: str | None = None) -> tuple[Outcome, xr.Dataset]:
+    """Run a scenario and measure it (``dashpots``: the SP scheme, default the engine's)."""
     t0 = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        ds = simulate(sc.model, sc.duration, record_interval=sc.record_interval, progress=False)
+        ds = simulate(sc.model, sc.duration, record_interval=sc.record_interval, dashpots=dashpots, progress=False)
     runtime = time.perf_counter() - t0
     pen = max_interpenetration(ds, frames=slice(None, None, overlap_every))
     created, scale = energy_creation(ds)
@@ -331,13 +331,13 @@ def evaluate(sc: Scenario, *, overlap_every: int = 1) -> tuple[Outcome, xr.Datas
     return out, ds
 
 
-def run_all(names: list[str] | None = None, *, short: bool = False) -> list[Outcome]:
+def run_all(names: list[str] | None = None, *, short: bool = False, dashpots: str | None = None) -> list[Outcome]:
     """Run the named scenarios (default all) and print one line each."""
     outs = []
     for name in names or list(SCENARIOS):
         try:
             sc = SCENARIOS[name](short=short)
-            out, _ = evaluate(sc, overlap_every=1 if short else 2)
+            out, _ = evaluate(sc, overlap_every=1 if short else 2, dashpots=dashpots)
         except Exception as exc:  # a scenario that cannot run is reported, not fatal
             print(f"{name:20s} FAILED: {type(exc).__name__}: {exc}", flush=True)
             continue
@@ -355,4 +355,4 @@ if __name__ == "__main__":  # pragma: no cover
 
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     _print_header()
-    run_all(args or None, short="--short" in sys.argv)
+    run_all(args or None, short="--short" in sys.argv, dashpots="explicit" if "--explicit" in sys.argv else None)

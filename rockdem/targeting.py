@@ -88,8 +88,10 @@ BRACKET_STEPS = 7
 """Most bracketing steps down from the critical beta (3^-7 ~ 1/2000 of it)."""
 MAX_XI = 30.0
 """Largest beta tried: xi = beta omega_max / 2 at most this (omega_max the probe's highest frequency
-at the release), i.e. an SP timestep reduction sqrt(1 + xi^2) - xi of at least 1/60: heavier damping
-would make every run of the model over 60 times longer than an undamped one. The 0.95 e_eta targets
+at the release), i.e. an SP timestep reduction sqrt(1 + xi^2) - xi of at least 1/60 with explicit
+dashpots: heavier damping would make every explicit run of the model over 60 times longer than an
+undamped one (implicit dashpots, the default, keep the undamped step, but a damping ratio of 30 at the
+highest contact frequency is far past any restitution target). The 0.95 e_eta targets
 of blocks of H/B = 1.5 to 20 with 2 to 15 points need xi = 2 to 7 (benchmarks/bench_damping.py)."""
 MAX_PROBE_WORK = 5e8
 """Largest probe run, in interface points of the probe model x steps (only a block's contacting

@@ -414,8 +414,10 @@ print it, so that fit is left open here.
 
 **Cost.** The per-interface run took {crit[steps_col]:.2f} times the steps of the 0.00025 s run and
 {crit['steps'] / one_value['steps']:.2f} times those of one beta critical at the return walls: per-interface damping costs
-what a single critical beta costs; critical damping itself costs the SP timestep reduction
-sqrt(1 + xi^2) - xi over the paper's light 0.00025 s (the engine's bound takes each block's largest beta).
+what a single critical beta costs. With the default implicit dashpots the step does not depend on beta, so
+critical damping costs what the paper's light 0.00025 s costs; with explicit dashpots (3DEC's scheme,
+`run.dashpots = "explicit"`) it costs the SP timestep reduction sqrt(1 + xi^2) - xi (the engine's bound
+takes each block's largest beta).
 Wall times of these sub-second runs, two at a time on a shared machine, are noisy: see
 benchmarks/bench_damping.py --facade for timed runs.
 """

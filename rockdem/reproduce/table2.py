@@ -139,8 +139,11 @@ def _comment(table: pd.DataFrame, ctx: Context) -> str:
 here against 6 to 54 hours in 3DEC (paper, Xeon E5-2698 v3); the growth with the number of points is
 {table['rockdem runtime / 2-point runtime'].iloc[-1]:.1f}x from 2 to {int(table['points across'].iloc[-1])} points
 against 9x in 3DEC. In rockdem the cost per step grows with the number of sub-contacts but the step count
-is set by the SP-reduced stable timestep, which depends on the stiffest contact mode and hardly on the
-point count (the total base stiffness is the same, split over more points). Runs were
+is set by the stable timestep, which depends on the stiffest contact mode and hardly on the
+point count (the total base stiffness is the same, split over more points). With rockdem's default
+implicit SP dashpots that step is the undamped one (docs/dashpots.md): {int(table['steps'].min()):,} to
+{int(table['steps'].max()):,} steps here, against 51,505 to 53,436 with 3DEC's explicit dashpots and their
+Belytschko-reduced step (`python benchmarks/dashpot_accuracy.py table2`). Runs were
 {'serial' if ctx.executor == 'serial' else 'executed concurrently on a shared machine'}; timings of sub-second
 runs are noisy.
 
