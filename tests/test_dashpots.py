@@ -1,0 +1,116 @@
+"""Implicit SP dashpots (rockdem.kernels.implicit, docs/dashpots.md): the stable step does not shrink
+with beta, the answer matches the converged explicit one, energy is never created, coupled blocks
+converge, and local damping is refused with a clear error."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rockdem.analysis import first_impact_time, summarize_result, wme
+from rockdem.case import load_case, parse_case
+from rockdem.materials import JointMaterial
+from rockdem.model import Damping, ModelBuilder
+from rockdem.reproduce.fig4 import sp_spec
+from rockdem.simulation import simulate
+from rockdem.timestep import DEFAULT_RESOLUTION, DEFAULT_SAFETY, stable_timestep
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+REFINE = 10
+"""The converged answer: explicit dashpots at a tenth of their default step throughout the run."""
+
+
+def _converged(model, duration: float, **kw):
+    return simulate(model, duration, dashpots="explicit", safety=DEFAULT_SAFETY / REFINE,
+                    resolution=DEFAULT_RESOLUTION / REFINE, progress=False, **kw)
+
+
+def _fig4(b: float, h: float):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return parse_case(sp_spec(b, h, 1800e6, 4.0).case_dict()).model
+
+
+def _block(beta: float, local: float = 0.0):
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial.from_modulus(1.8e9, 2.0, friction_angle=89.0)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground", group="ground")
+    b.add_box(0.2, 1.0, 2.0, density=1800, name="wall")
+    b.tilt("wall", 0.9)
+    return b.finalize(damping=Damping(beta=beta, local=local))
+
+
+def _created(ds) -> float:
+    """Largest KE + PE - initial - work over the run, over the energy scale."""
+    e = ds.energy_kinetic.values + ds.energy_potential.values
+    work = ds.work_driven.values + ds.work_body.values
+    return float(np.max(e - e[0] - (work - work[0]))) / float(np.max(np.abs(e - e[-1])) + 1e-30)
+
+
+def test_the_implicit_step_is_the_undamped_one_and_the_explicit_one_is_belytschkos():
+    undamped = stable_timestep(_block(0.0))
+    for beta in (0.00693, 0.05):
+        imp, exp = stable_timestep(_block(beta), dashpots="implicit"), stable_timestep(_block(beta), dashpots="explicit")
+        assert imp.dt == pytest.approx(undamped.dt, rel=1e-12) and imp.sp_factor == 1.0
+        xi = 0.5 * beta * exp.omega_max
+        f = math.sqrt(1.0 + xi * xi) - xi
+        assert exp.sp_factor == pytest.approx(f, rel=1e-9)
+        assert exp.dt == pytest.approx(min(DEFAULT_SAFETY * f, DEFAULT_RESOLUTION) * 2.0 / exp.omega_max, rel=1e-9)
+        assert imp.damping_ratio == pytest.approx(xi, rel=1e-9)
+
+
+@pytest.mark.parametrize("b, h", [(0.19, 2.0), (0.35, 0.5)])
+def test_implicit_dashpots_match_the_converged_explicit_answer(b, h):
+    """Issue 12's accuracy targets on a slender and a squat Fig. 4 block (DeJong's beta)."""
+    model = _fig4(b, h)
+    ref = _converged(model, 4.0, record_interval=0.0005)
+    ds = simulate(model, 4.0, record_interval=0.0005, progress=False)
+    assert ds.attrs["dashpots"] == "implicit"
+    assert ds.attrs["steps"] * 2.5 < simulate(model, 4.0, dashpots="explicit", progress=False).attrs["steps"]
+    k = int(np.flatnonzero(ds.block_free.values)[0])
+    t, th, tr, thr = ds.time.values, ds.rocking_angle.values[:, k], ref.time.values, ref.rocking_angle.values[:, k]
+    assert wme(tr, thr, t, th) <= 0.01
+    assert summarize_result(ds, k)["e_a_mean"] == pytest.approx(summarize_result(ref, k)["e_a_mean"], rel=0.005)
+    assert first_impact_time(t, th) == pytest.approx(first_impact_time(tr, thr), rel=0.001)
+    assert abs(float(ds.energy_balance_error_relative.values[-1])) < 0.005
+    assert _created(ds) <= 1e-3
+
+
+def test_heavy_damping_is_stable_at_the_undamped_step_and_creates_no_energy():
+    """beta = 0.5 s: a damping ratio of about 200 at the highest contact frequency (the explicit step
+    would be 1/400 of the undamped one). The block settles onto its base without gaining energy."""
+    model = _block(0.5)
+    info = stable_timestep(model)
+    assert info.damping_ratio > 100 and info.dt == pytest.approx(stable_timestep(_block(0.0)).dt, rel=1e-12)
+    ds = simulate(model, 2.0, progress=False)
+    assert not ds.attrs.get("diverged", False)
+    assert _created(ds) <= 1e-6
+    assert float(ds.energy_kinetic.values[-1]) < float(ds.energy_kinetic.values.max())
+
+
+def test_coupled_blocks_converge_and_match_the_converged_answer():
+    """The two-block wall: the upper block's dashpots couple two free blocks (block-Jacobi sweeps)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model = parse_case(load_case(EXAMPLES / "two_block_wall_free_rocking.toml")).model
+    ds = simulate(model, 2.0, record_interval=0.001, progress=False)
+    ref = _converged(model, 2.0, record_interval=0.001)
+    assert ds.attrs["dashpot_sweeps"] > ds.attrs["steps"] and ds.attrs["dashpot_unconverged_steps"] == 0
+    for k in np.flatnonzero(ds.block_free.values):
+        th, thr = ds.rocking_angle.values[:, k], ref.rocking_angle.values[:, k]
+        assert np.max(np.abs(th - thr)) <= 0.02 * np.max(np.abs(thr))
+    assert abs(float(ds.energy_balance_error_relative.values[-1])) < 0.005
+    assert _created(ds) <= 1e-3
+
+
+def test_local_damping_is_refused_with_implicit_dashpots_and_auto_falls_back():
+    model = _block(0.00693, local=0.1)
+    with pytest.raises(ValueError, match=r"dashpots = 'implicit' cannot be combined with local damping.*'explicit'"):
+        simulate(model, 0.01, dashpots="implicit", progress=False)
+    assert simulate(model, 0.01, progress=False).attrs["dashpots"] == "explicit"
+    with pytest.raises(ValueError, match="dashpots must be 'auto', 'implicit' or 'explicit'"):
+        simulate(_block(0.00693), 0.01, dashpots="trapezoid", progress=False)
