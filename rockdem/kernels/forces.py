@@ -457,6 +457,24 @@ def _blend(m: ModelArrays, s: State, sc: Scratch, i: int, fa: int, fb: int, a: i
     return lam, dlam
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _released_dashpot(
+    fd: np.ndarray, vd: np.ndarray, c: float, kn: float, ks: float, v0: float, v1: float, v2: float,
+    vn: float, n0: float, n1: float, n2: float,
+) -> tuple[float, float, float]:
+    """Force [N] of a dashpot at its first step out of contact (implicit dashpots):
+    -c (kn v_n n + ks v_s), c [s m^2 or s] beta x its share of the step (x the area for a
+    sub-contact), at the relative velocity v [m/s] (normal part vn along n); stored with that
+    velocity in ``fd``, ``vd`` (3,) for the work of :func:`rockdem.kernels.implicit.finalize`."""
+    vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
+    d0 = -c * (kn * vn * n0 + ks * vs0)
+    d1 = -c * (kn * vn * n1 + ks * vs1)
+    d2 = -c * (kn * vn * n2 + ks * vs2)
+    fd[0], fd[1], fd[2] = d0, d1, d2
+    vd[0], vd[1], vd[2] = v0, v1, v2
+    return d0, d1, d2
+
+
 @njit(cache=True, _nrt=False)
 def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -> float:
     """Sub-contacts that opened during the last step (listed by :func:`_law_pass`): complete the
@@ -497,17 +515,8 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
         if s.dashpots[0] == DASHPOTS_IMPLICIT and vn > 0.0 and m.mat_beta[go, gt] > 0.0:
             # Implicit dashpots: the dashpot acted until the opening; its share of this velocity step
             # (negative: the last step applied it past the opening), at the last half step's velocity.
-            beta = m.mat_beta[go, gt] * dashpot_release_share(un, vn, dt) * prev_area
-            vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
-            d0 = -beta * (kn * vn * n0 + ks * vs0)
-            d1 = -beta * (kn * vn * n1 + ks * vs1)
-            d2 = -beta * (kn * vn * n2 + ks * vs2)
-            sc.dashpot_force[k, 0] = d0
-            sc.dashpot_force[k, 1] = d1
-            sc.dashpot_force[k, 2] = d2
-            sc.dashpot_velocity[k, 0] = v0
-            sc.dashpot_velocity[k, 1] = v1
-            sc.dashpot_velocity[k, 2] = v2
+            c = m.mat_beta[go, gt] * dashpot_release_share(un, vn, dt) * prev_area
+            d0, d1, d2 = _released_dashpot(sc.dashpot_force[k], sc.dashpot_velocity[k], c, kn, ks, v0, v1, v2, vn, n0, n1, n2)
             c0 += d0
             c1 += d1
             c2 += d2
@@ -592,14 +601,9 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
             fnc = kna * ramp_overlap(un, un_prev, vn, dt)
             c0, c1, c2, e = release_shear(us0, us1, us2, ksa, m.mat_res_tan_friction[ga, gb] * kna, un_prev, vn, vs0, vs1, vs2, dt)
             if s.dashpots[0] == DASHPOTS_IMPLICIT and vn > 0.0 and m.mat_beta[ga, gb] > 0.0:  # as in _release_pass
-                rel = m.mat_beta[ga, gb] * dashpot_release_share(un, vn, dt)
-                d0, d1, d2 = -rel * (kna * vn * n0 + ksa * vs0), -rel * (kna * vn * n1 + ksa * vs1), -rel * (kna * vn * n2 + ksa * vs2)
-                sc.pair_dashpot_force[i, 0] = d0
-                sc.pair_dashpot_force[i, 1] = d1
-                sc.pair_dashpot_force[i, 2] = d2
-                sc.pair_dashpot_velocity[i, 0] = v0
-                sc.pair_dashpot_velocity[i, 1] = v1
-                sc.pair_dashpot_velocity[i, 2] = v2
+                c = m.mat_beta[ga, gb] * dashpot_release_share(un, vn, dt)
+                d0, d1, d2 = _released_dashpot(sc.pair_dashpot_force[i], sc.pair_dashpot_velocity[i], c, kna, ksa,
+                                               v0, v1, v2, vn, n0, n1, n2)
                 c0 += d0
                 c1 += d1
                 c2 += d2

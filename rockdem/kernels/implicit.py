@@ -364,20 +364,18 @@ def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
         for k in range(k0, k1):
             cn, cs, x0, x1, x2, n0, n1, n2 = _dashpot(s, sc, i, k, edge)
             o, t = (a, b) if k < split else (b, a)
+            fd = sc.pair_dashpot_force[i] if edge else sc.dashpot_force[k]
+            vd = sc.pair_dashpot_velocity[i] if edge else sc.dashpot_velocity[k]
             if cn <= 0.0:
                 # No implicit share; a dashpot released during the last step had its share of this
                 # step applied at the last half step's velocity (forces._release_pass): its work.
-                fd = sc.pair_dashpot_force[i] if edge else sc.dashpot_force[k]
                 if fd[0] == 0.0 and fd[1] == 0.0 and fd[2] == 0.0:
                     continue
-                vd = sc.pair_dashpot_velocity[i] if edge else sc.dashpot_velocity[k]
                 vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vd[0], vd[1], vd[2])
                 e -= h * (fd[0] * vm0 + fd[1] * vm1 + fd[2] * vm2)
                 continue
-            if edge:
-                vm0, vm1, vm2 = sc.pair_dashpot_velocity[i, 0], sc.pair_dashpot_velocity[i, 1], sc.pair_dashpot_velocity[i, 2]
-            else:
-                vm0, vm1, vm2 = sc.dashpot_velocity[k, 0], sc.dashpot_velocity[k, 1], sc.dashpot_velocity[k, 2]
+            fc = sc.pair_force[i] if edge else sc.contact_force[k]
+            vm0, vm1, vm2 = vd[0], vd[1], vd[2]
             uo0, uo1, uo2 = _new_point_velocity(s, sc, o, x0, x1, x2)
             ut0, ut1, ut2 = _new_point_velocity(s, sc, t, x0, x1, x2)
             vp0, vp1, vp2 = uo0 - ut0, uo1 - ut1, uo2 - ut2
@@ -386,26 +384,13 @@ def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
             g1 = -0.5 * (cs * vp1 + pn * n1)
             g2 = -0.5 * (cs * vp2 + pn * n2)
             vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vm0, vm1, vm2)
-            if edge:
-                f0 = sc.pair_dashpot_force[i, 0] + g0
-                f1 = sc.pair_dashpot_force[i, 1] + g1
-                f2 = sc.pair_dashpot_force[i, 2] + g2
-                sc.pair_dashpot_force[i, 0] = f0
-                sc.pair_dashpot_force[i, 1] = f1
-                sc.pair_dashpot_force[i, 2] = f2
-                sc.pair_force[i, 0] += g0
-                sc.pair_force[i, 1] += g1
-                sc.pair_force[i, 2] += g2
-            else:
-                f0 = sc.dashpot_force[k, 0] + g0
-                f1 = sc.dashpot_force[k, 1] + g1
-                f2 = sc.dashpot_force[k, 2] + g2
-                sc.dashpot_force[k, 0] = f0
-                sc.dashpot_force[k, 1] = f1
-                sc.dashpot_force[k, 2] = f2
-                sc.contact_force[k, 0] += g0
-                sc.contact_force[k, 1] += g1
-                sc.contact_force[k, 2] += g2
+            fd[0] += g0
+            fd[1] += g1
+            fd[2] += g2
+            fc[0] += g0
+            fc[1] += g1
+            fc[2] += g2
+            f0, f1, f2 = fd[0], fd[1], fd[2]
             _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, g0, g1, g2, x0, x1, x2)
             e -= h * (f0 * vm0 + f1 * vm1 + f2 * vm2)
     return e
