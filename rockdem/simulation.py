@@ -103,9 +103,10 @@ def simulate(
             step whatever beta, :mod:`rockdem.kernels.implicit`), "explicit" (on the last half step's
             velocities with Belytschko's step reduction, as 3DEC does) or "auto" (default, None:
             implicit, explicit with local damping); see ``docs/dashpots.md``.
-        record_interval: time between recorded frames [s] (default 0.002). Frame k is recorded at
-            the step nearest to k record_interval: its time (the ``time`` coordinate, exact) lies
-            within half a step of it.
+        record_interval: time between recorded frames [s] (default 0.002). Frame k is at exactly
+            k record_interval: poses and velocities on the leapfrog path at that time (the step
+            need not divide the interval); energies, contact counts and reactions are those of the
+            step nearest to it (within half a step).
         monitors: named points whose world displacement is recorded, e.g.
             ``{"top": ("wall", (0.1, 0.0, 2.0))}``: block and world position [m] in the reference
             configuration (before any initial tilt); displacements are measured from there.

@@ -11,6 +11,7 @@ import pytest
 from rockdem.case import apply_overrides, example_case, parse_case
 from rockdem.cli import main
 from rockdem.materials import JointMaterial
+from rockdem.geometry import box
 from rockdem.model import Damping, ModelBuilder
 from rockdem.results import contact_table, load, save, write_contact_table
 from rockdem.simulation import simulate
@@ -102,13 +103,38 @@ def test_export_writes_at_most_the_default_number_of_frames(tmp_path, capsys):
     assert "every 50th" in capsys.readouterr().out
 
 
-def test_frames_are_recorded_at_the_step_nearest_each_multiple_of_the_interval():
-    # The documented rule (simulate's record_interval): frame k at the first step with
-    # t >= k dt_rec - dt/2, so |t_k - k dt_rec| <= dt/2 with dt the step then taken (at most the
-    # initial dt, as the step is only lowered); the time coordinate is the exact engine time.
+def test_frames_are_recorded_at_exact_multiples_of_the_interval():
+    # Poses and velocities are taken on the leapfrog trajectory at k dt_rec (kernels.step._record_pose).
     ds = example_result()
     t = ds.time.values
     k = np.arange(t.size)
-    dt0 = ds.attrs["dt"]
-    assert np.max(np.abs(t - k * 0.01)) <= 0.5 * dt0 + 1e-12
-    assert np.all(np.abs(np.diff(t) - 0.01) <= dt0 + 1e-12)  # spacing: the interval within one step
+    assert np.max(np.abs(t - k * 0.01)) <= 1e-12
+
+
+def test_frames_between_steps_follow_free_flight_exactly():
+    """A block thrown upward and spinning, no contact (closed forms): the spin angle is omega t and
+    the height the parabola z0 + v t - g t^2 / 2 at each frame time, although the frames (every
+    7 ms) fall between steps. The leapfrog path is off its parabola by at most g dt^2 / 8 between
+    steps; a frame taken at the nearest step instead would be off by up to |v| dt / 2 in height
+    and omega dt / 2 in angle. (rockdem takes the initial velocity as that of the half step before
+    t = 0, so the parabola's v(0) is v0 - g dt / 2.)"""
+    b = ModelBuilder()
+    b.default_material = JointMaterial.from_modulus(1.8e9, 0.4)
+    b.add_box(1.0, 1.0, 0.1, base_center=(0, 0, -5.0), driven=True, name="far ground")
+    b.add_block(box(0.2, 0.3, 0.4, center=(0.0, 0.0, 1.0)), name="thrown", velocity=(0.0, 0.0, 3.0),
+                angular_velocity=(0.0, 5.0, 0.0))
+    model = b.finalize()
+    ds = simulate(model, 0.5, record_interval=0.007, progress=False)
+    t = ds.time.values
+    dt = ds.attrs["dt"]
+    assert 0.007 / dt % 1.0 > 0.05  # the frames do fall between steps
+    k = int(np.flatnonzero(ds.block_free.values)[0])
+    z = ds.block_position.values[:, k, 2]
+    v_start = 3.0 - 0.5 * 9.81 * dt
+    exact = 1.0 + v_start * t - 0.5 * 9.81 * t * t
+    assert np.max(np.abs(z - exact)) <= 9.81 * dt * dt / 8 + 1e-12
+    assert np.max(np.abs(z - exact)) < 0.01 * 3.0 * 0.5 * dt  # far below the nearest-step error
+    vz = ds.block_velocity.values[:, k, 2]
+    assert np.max(np.abs(vz - (v_start - 9.81 * t))) <= 1e-9
+    angle = np.abs(ds.block_rotation.values[:, k, 1])
+    assert np.max(np.abs(angle - 5.0 * t)[5.0 * t < np.pi]) <= 1e-9

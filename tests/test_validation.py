@@ -272,9 +272,9 @@ def test_a_block_sinking_into_far_too_soft_joints_stops_the_run():
     b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
     b.add_box(0.2, 1, 1, density=1800, name="block")
     with pytest.warns(RuntimeWarning, match="sank"):
-        ds = simulate(b.finalize(), 3.0, progress=False)
+        ds = simulate(b.finalize(), 20.0, progress=False)
     assert ds.attrs["diverged"] == 1 and ds.attrs["diverged_reason"] == "sank" and ds.attrs["diverged_blocks"] == "block"
-    assert float(ds.time[-1]) < 3.0
+    assert ds.attrs["diverged_time"] < 20.0 and float(ds.time[-1]) < 20.0  # stopped, keeping the frames computed
     sink = -float(ds.block_position.values[-1, 1, 2] - 0.5)
     assert sink > SINK_FRACTION * 0.2 * 0.5  # it had sunk well into the ground when it stopped
 

@@ -26,7 +26,13 @@ def quat_to_matrix(q: np.ndarray, r: np.ndarray) -> None:
 @njit(cache=True, _nrt=False)
 def quat_integrate(q: np.ndarray, wb: np.ndarray, dt: float) -> None:
     """q <- q * exp(wb dt / 2) in place: rotate by body-frame angular velocity ``wb`` [rad/s] over dt."""
-    wx, wy, wz = wb[0] * dt, wb[1] * dt, wb[2] * dt
+    quat_integrate_xyz(q, wb[0], wb[1], wb[2], dt)
+
+
+@njit(cache=True, _nrt=False)
+def quat_integrate_xyz(q: np.ndarray, w0: float, w1: float, w2: float, dt: float) -> None:
+    """:func:`quat_integrate` with the body-frame angular velocity (w0, w1, w2) [rad/s] as scalars."""
+    wx, wy, wz = w0 * dt, w1 * dt, w2 * dt
     ang = math.sqrt(wx * wx + wy * wy + wz * wz)
     if ang < 1e-14:
         return

@@ -49,7 +49,7 @@ from .layout import (
     Scratch,
     State,
 )
-from .rotation import quat_integrate
+from .rotation import quat_integrate, quat_integrate_xyz
 from .series import interpolate
 
 DIVERGENCE_ERROR = 0.2
@@ -84,12 +84,55 @@ def _free_energies(
     return e_mp, w_body, ke, pe
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _record_pose(
+    s: State, sc: Scratch, rec: Records, frame: int, b: int, tau: float, h: float, w_old: float, w_new: float
+) -> None:
+    """Record block b's pose and velocities at the frame time t_n + tau (|tau| <= half a step) on the
+    leapfrog trajectory: x = x_n + tau v (v the half-step velocity on tau's side, the path the scheme
+    itself takes between t_n and t_n +- one step), q the exponential map of tau omega; velocities
+    from their values at t_n (``sc.velocity_mid``, ``sc.omega_mid``) plus tau times the step's
+    acceleration (v_{n+1/2} - v_{n-1/2}) / h. v_{n-1/2} is recovered from the value at t_n, the
+    interpolation of the two half-step velocities with weights w_old, w_new."""
+    r = sc.rotation[b]
+    wn = s.omega[b]
+    wm = sc.omega_mid[b]
+    q = rec.quaternion[frame, b]
+    for i in range(4):
+        q[i] = s.quaternion[b, i]
+    if tau == 0.0:
+        for i in range(3):
+            rec.position[frame, b, i] = s.position[b, i]
+            rec.velocity[frame, b, i] = sc.velocity_mid[b, i]
+            rec.omega[frame, b, i] = wm[i]
+        return
+    for i in range(3):
+        vn = s.velocity[b, i]
+        vo = (sc.velocity_mid[b, i] - w_new * vn) / w_old
+        rec.position[frame, b, i] = s.position[b, i] + tau * (vn if tau > 0.0 else vo)
+        rec.velocity[frame, b, i] = sc.velocity_mid[b, i] + tau * (vn - vo) / h
+    # Angular velocity at t_n in the body frame, and that of the last half step recovered from it.
+    wb0 = r[0, 0] * wm[0] + r[1, 0] * wm[1] + r[2, 0] * wm[2]
+    wb1 = r[0, 1] * wm[0] + r[1, 1] * wm[1] + r[2, 1] * wm[2]
+    wb2 = r[0, 2] * wm[0] + r[1, 2] * wm[1] + r[2, 2] * wm[2]
+    wo0, wo1, wo2 = (wb0 - w_new * wn[0]) / w_old, (wb1 - w_new * wn[1]) / w_old, (wb2 - w_new * wn[2]) / w_old
+    if tau > 0.0:
+        quat_integrate_xyz(q, wn[0], wn[1], wn[2], tau)
+    else:
+        quat_integrate_xyz(q, wo0, wo1, wo2, tau)
+    d0, d1, d2 = wn[0] - wo0, wn[1] - wo1, wn[2] - wo2
+    for i in range(3):
+        rec.omega[frame, b, i] = wm[i] + tau * (r[i, 0] * d0 + r[i, 1] * d1 + r[i, 2] * d2) / h
+
+
 @njit(cache=True, _nrt=False)
 def integrate_velocities(
-    m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int, step: float
+    m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int, frame_end: int,
+    step: float, interval: float,
 ) -> None:
     """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` [s] (the mean of the last and the next
-    step); records frame ``frame`` (if >= 0) at t_n.
+    step); records frames ``frame`` to ``frame_end`` - 1 (none if equal), frame k at its time
+    k ``interval`` [s] within half a step of t_n (several when the step exceeds the interval).
 
     Driven blocks first take their prescribed velocity at the middle of the next position step
     ``step`` [s]. A free block with an active
@@ -224,31 +267,26 @@ def integrate_velocities(
     jd = 0
     for b in range(nb):
         if not m.block_free[b]:
-            if frame >= 0:
+            for f in range(frame, frame_end):
                 for i in range(3):
-                    rec.driven_reaction[frame, jd, i] = -sc.force[b, i]
+                    rec.driven_reaction[f, jd, i] = -sc.force[b, i]
             jd += 1
             for i in range(3):
                 w_drv -= sc.force[b, i] * s.velocity[b, i] * dt
-        if frame >= 0:
-            for i in range(3):
-                rec.position[frame, b, i] = s.position[b, i]
-                rec.velocity[frame, b, i] = sc.velocity_mid[b, i]
-                rec.omega[frame, b, i] = sc.omega_mid[b, i]
-            for i in range(4):
-                rec.quaternion[frame, b, i] = s.quaternion[b, i]
+        for f in range(frame, frame_end):
+            _record_pose(s, sc, rec, f, b, f * interval - t, dt, w_old, w_new)
     s.energy[E_DAMPING_MASS] += e_mp
     s.energy[E_LOCAL_DAMPING] += e_loc
     s.energy[W_BODY] += w_body
     s.energy[W_DRIVEN] += w_drv
-    if frame >= 0:
-        rec.time[frame] = t
+    for f in range(frame, frame_end):
+        rec.time[f] = f * interval
         for i in range(s.energy.shape[0]):
-            rec.energy[frame, i] = s.energy[i]
-        rec.energy[frame, E_KINETIC] = ke
-        rec.energy[frame, E_POTENTIAL] = pe
-        rec.energy[frame, E_ELASTIC] = sc.elastic_energy[0]
-        _record_counts(s, sc, rec, frame)
+            rec.energy[f, i] = s.energy[i]
+        rec.energy[f, E_KINETIC] = ke
+        rec.energy[f, E_POTENTIAL] = pe
+        rec.energy[f, E_ELASTIC] = sc.elastic_energy[0]
+        _record_counts(s, sc, rec, f)
 
 
 @njit(cache=True, _nrt=False)
@@ -405,24 +443,25 @@ def advance(
                 s.dt_min[0] = min(s.dt_min[0], safe)
         t = s.time[0]
         dt = s.dt[0]
-        now = -1
-        if frame < rec.time.shape[0] and t >= frame * record_interval - 0.5 * dt:
-            now = frame  # the step nearest to the frame's time
+        # Frames whose time is nearest to this step (k interval <= t + dt / 2, not yet recorded).
+        end = frame
+        while end < rec.time.shape[0] and end * record_interval <= t + 0.5 * dt:
+            end += 1
         step = dt
         h = 0.5 * (s.dt_prev[0] + step)
         # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + step/2]
         # (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.25 * (step - s.dt_prev[0]), s.dt_prev[0])
-        integrate_velocities(m, s, sc, t, h, rec, now, step)
+        integrate_velocities(m, s, sc, t, h, rec, frame, end, step, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT:
             dashpot_work(m, s, sc, h)
         integrate_positions(m, s, step)
         s.dt_prev[0] = step
         s.time[0] = t + step
         s.step[0] += 1
-        if now >= 0:
-            frame += 1
-            status = check_frame(m, s, sc, rec, now)
+        if end > frame:
+            frame = end
+            status = check_frame(m, s, sc, rec, end - 1)
             if status != STATUS_DONE:
                 return frame, status
     return frame, STATUS_DONE
