@@ -71,6 +71,15 @@ def _count(name: str, value: int, max_: int | None = None) -> int:
     return int(value)
 
 
+def _brick(brick: object) -> tuple[float, float]:
+    """A ``brick`` argument as (length along y, height) [m], both positive; ValueError otherwise."""
+    try:
+        by, bz = (float(v) for v in brick)  # type: ignore[attr-defined]
+    except (TypeError, ValueError):
+        raise ValueError(f"brick must be (length along y, height) [m] or None, got {brick!r}") from None
+    return _positive("brick[0] (length, y)", by), _positive("brick[1] (height, z)", bz)
+
+
 def _material(name: str, material: JointMaterial | None) -> JointMaterial | None:
     if material is not None and not isinstance(material, JointMaterial):
         raise ValueError(f"{name} must be a JointMaterial or None (the builder's default_material), got {material!r}")
@@ -391,12 +400,7 @@ def parapet(
     material = _material("material", material)
     base_material = _material("base_material", base_material)
     if brick is not None:
-        try:
-            by, bz = (float(v) for v in brick)
-        except (TypeError, ValueError):
-            raise ValueError(f"brick must be (length along y, height) [m] or None, got {brick!r}") from None
-        _positive("brick[0] (length, y)", by)
-        _positive("brick[1] (height, z)", bz)
+        by, bz = _brick(brick)
         nb = max(1, round(ln / by))
         nc = max(1, round(h / bz))
         _block_count(f"brick = ({by}, {bz}) m on a {ln} x {h} m parapet", nc * (nb + 1))
@@ -510,12 +514,7 @@ def facade(
     material = _material("material", material)
     return_material = _material("return_material", return_material)
     if brick is not None:
-        try:
-            by, bz = (float(v) for v in brick)
-        except (TypeError, ValueError):
-            raise ValueError(f"brick must be (length along y, height) [m] or None, got {brick!r}") from None
-        _positive("brick[0] (length, y)", by)
-        _positive("brick[1] (height, z)", bz)
+        by, bz = _brick(brick)
         if r > 0 or rocking_velocity != 0.0:
             raise ValueError("edge_radius and rocking_velocity apply to the single-block façade; give 0 with brick")
         if bond not in BONDS:

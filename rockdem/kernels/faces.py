@@ -186,6 +186,19 @@ def covered(
 
 
 @njit(cache=True, _nrt=False, inline="always")
+def _cell_to_target(cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.ndarray, p: int, fm: FaceMap) -> int:
+    """Cell p's polygon in the target face's coordinates into ``buf[0]``; returns its vertex count."""
+    c0 = cell_start[p]
+    nv = cell_start[p + 1] - c0
+    for k in range(nv):
+        cu = cell_vertex[c0 + k, 0]
+        cw = cell_vertex[c0 + k, 1]
+        buf[0, k, 0] = fm.m00 * cu + fm.m01 * cw + fm.t0
+        buf[0, k, 1] = fm.m10 * cu + fm.m11 * cw + fm.t1
+    return nv
+
+
+@njit(cache=True, _nrt=False, inline="always")
 def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
@@ -212,13 +225,7 @@ def partly_covered(
     stiffness still falls continuously to zero as the overlapping part leaves the partner. Where the
     whole cell overlaps (a flat joint) this is the covered area itself.
     """
-    c0 = cell_start[p]
-    nv = cell_start[p + 1] - c0
-    for k in range(nv):
-        cu = cell_vertex[c0 + k, 0]
-        cw = cell_vertex[c0 + k, 1]
-        buf[0, k, 0] = fm.m00 * cu + fm.m01 * cw + fm.t0
-        buf[0, k, 1] = fm.m10 * cu + fm.m11 * cw + fm.t1
+    nv = _cell_to_target(cell_start, cell_vertex, buf, p, fm)
     xu = fm.m00 * nu + fm.m01 * nw + fm.t0
     xw = fm.m10 * nu + fm.m11 * nw + fm.t1
     node_in = True
@@ -287,13 +294,7 @@ def _lumped_area(
     lo = -(fm.h0 - gu * fm.t0 - gw * fm.t1)
     m = clip_halfplane(buf, cur, n, gu, gw, lo)
     covered_below = abs(polygon_area(buf, 1 - cur, m)) / abs(fm.det) if m >= 3 else 0.0
-    c0 = cell_start[p]
-    nv = cell_start[p + 1] - c0
-    for k in range(nv):
-        cu = cell_vertex[c0 + k, 0]
-        cw = cell_vertex[c0 + k, 1]
-        buf[0, k, 0] = fm.m00 * cu + fm.m01 * cw + fm.t0
-        buf[0, k, 1] = fm.m10 * cu + fm.m11 * cw + fm.t1
+    nv = _cell_to_target(cell_start, cell_vertex, buf, p, fm)
     m = clip_halfplane(buf, 0, nv, gu, gw, lo)
     below = abs(polygon_area(buf, 1, m)) / abs(fm.det) if m >= 3 else 0.0
     if below <= 1e-12 * point_area:

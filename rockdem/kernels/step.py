@@ -447,17 +447,16 @@ def advance(
         end = frame
         while end < rec.time.shape[0] and end * record_interval <= t + 0.5 * dt:
             end += 1
-        step = dt
-        h = 0.5 * (s.dt_prev[0] + step)
-        # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + step/2]
+        h = 0.5 * (s.dt_prev[0] + dt)
+        # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + dt/2]
         # (t itself unless the step was just lowered).
-        compute_forces(m, s, sc, t + 0.25 * (step - s.dt_prev[0]), s.dt_prev[0])
-        integrate_velocities(m, s, sc, t, h, rec, frame, end, step, record_interval)
+        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0])
+        integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT:
             dashpot_work(m, s, sc, h)
-        integrate_positions(m, s, step)
-        s.dt_prev[0] = step
-        s.time[0] = t + step
+        integrate_positions(m, s, dt)
+        s.dt_prev[0] = dt
+        s.time[0] = t + dt
         s.step[0] += 1
         if end > frame:
             frame = end
