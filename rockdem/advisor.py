@@ -19,7 +19,8 @@ B (rocking direction), height H and length L:
 * on request, the beta of the model itself (a block, a stack or a one-sided façade with these
   inputs, built with :mod:`rockdem.specimens`): targeted to a restitution (``target_restitution``:
   short free-rocking runs, :mod:`rockdem.targeting`) and/or per joint group pair from each pair's
-  own critical impact (``per_interface``: beta = 2 zeta / sqrt(kn A / m), :mod:`rockdem.interfaces`).
+  own critical impact (``per_interface``: beta = 2 zeta / sqrt(kn A / m), a face across a gap struck by
+  one row of points with the block's effective mass there, :mod:`rockdem.interfaces`).
 
 Geometry of the rocking body: the whole element B x H for ``single`` and ``one-sided``; one block
 B x (H / blocks) for ``stacked`` (each block of the stack rocks and impacts its neighbours). More
@@ -472,7 +473,8 @@ def _recommended(i: AdviceInput, beta_rule: float, choice: BetaChoice | None) ->
         per = "; ".join(f"{p.label} {p.beta:.4g} s" for p in choice.pairs if p.source == "critical")
         return choice.beta, (
             f"Per interface (damping.beta = \"critical\"): each joint group pair beta = 2 zeta / omega of its own "
-            f"critical impact, omega = sqrt(kn A / m) with the model's springs (Eq. 1-4): {per}; the number is the "
+            f"critical impact, omega = sqrt(kn A / m) with the model's springs (Eq. 1-4; a face across a gap "
+            f"struck by one row of points, A its area, m the block's effective mass there): {per}; the number is the "
             "largest of them."
         )
     rule = "x sqrt 2 (stacked, §2.2)" if i.configuration is Configuration.STACKED else (
@@ -595,6 +597,7 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
                         "number in (0, 1); a few seconds")
     p.add_argument("--per-interface", action="store_true",
                    help="each joint group pair its own critical beta = 2 zeta / sqrt(kn A / m) of its own impact "
+                        "(across a gap: one row of points, the effective mass there) "
                         "(with --target-restitution: the targeted beta on the rocking interface, critical elsewhere)")
     p.add_argument("--release-fraction", type=float, default=None,
                    help="release of the targeted search's free-rocking probe, fraction of eta (default 0.5)")

@@ -17,10 +17,23 @@ walls gives the return walls' end faces' area, its own horizontally stacked impa
 paper's Eq. 2 writes k_s = k_j B / 2 with k_j = E B / H; with k_j = kn A the stiffness of the joint,
 each corner spring is k_j / 2, and the extra factor B [m] of Eq. 2 makes Eq. 3's omega_e smaller by
 sqrt(B / 1 m) (and its beta larger by 1 / sqrt(B / 1 m): the façade's two-sided 0.0047 s is
-0.0016 s here, the parapet's 0.00305 s is 0.0015 s). The rotational mode of a rocking impact is
-slower than this translational one (for the façade on its return walls by H^2 / (B^2 + H^2)), so
-omega is the highest impact frequency of the pair, the paper's choice (§2.2: it affects the timestep
-the least). Per group pair the largest omega over its interfaces gives
+0.0016 s here, the parapet's 0.00305 s is 0.0015 s).
+
+**Strike by one row across a gap.** Faces that start apart (a one-sided façade 4 mm in front of its
+return walls) while the block stands on a support (faces touching in another direction) do not
+land flat: the block rocks about its base and closes the gap with the edge row
+of interface points farthest from the pivot (the façade's top points) while the rest is still
+open. The impact force is orders of magnitude above the base friction mu m g, so during the strike
+the block is free, and the row of area A_r at r from the centre of mass meets an effective mass
+
+    1 / m_eff = 1 / m + (r x n) . I^-1 (r x n)     (plus the same term of a free partner),
+    omega = sqrt(kn A_r / m_eff).
+
+For the §4.2 façade (top row A_r = A / 2, 1 / m_eff = (1 / m)(1 + 3 H^2 / (B^2 + H^2))) this is
+1.40 sqrt(kn A / m); the recorded strike's undamped contact time gives 1.39. For such faces omega is
+the larger of this and the flat landing; rows are the points along each edge of the convex hull of
+the interface's points. Touching faces keep the flat landing (all their rows are in contact at once:
+the paper's edge impact). Per group pair the largest omega over its interfaces gives
 
     beta = 2 zeta / omega    (Eq. 4 with alpha = 0; zeta = 1 is critical damping).
 
@@ -31,7 +44,7 @@ of the pair landing on its largest face; a pair of two driven groups never acts 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Sequence
 
 import numpy as np
@@ -60,6 +73,10 @@ class Body:
         name: block name. group: its joint-material group.
         poly: its geometry in the reference (untilted) pose [m].
         mass: [kg]. free: False for driven blocks.
+        centre: (3,) centre of mass [m]. inertia: (3, 3) inertia tensor about it, world axes [kg m^2].
+        points: (k, 3) interface points [m], point_areas: (k,) their tributary areas [m^2],
+            point_faces: (k,) the index of each point's face in ``poly.faces`` (empty: none known,
+            the strike of a gap interface is then not computed).
     """
 
     name: str
@@ -67,6 +84,11 @@ class Body:
     poly: Polyhedron
     mass: float
     free: bool
+    centre: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    inertia: NDArray[np.float64] = field(default_factory=lambda: np.zeros((3, 3)))
+    points: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 3)))
+    point_areas: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    point_faces: NDArray[np.int64] = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 @dataclass(frozen=True)
@@ -77,6 +99,7 @@ class FaceContact:
         normal: (3,) outward unit normal of a's face (from a towards b).
         area: overlap area of the two faces [m^2].
         gap: distance between the two face planes [m] (negative: overlapping).
+        face_a, face_b: the two faces, indices into ``poly.faces`` of a and b.
     """
 
     a: int
@@ -84,6 +107,8 @@ class FaceContact:
     normal: NDArray[np.float64]
     area: float
     gap: float
+    face_a: int = -1
+    face_b: int = -1
 
 
 def _face_frames(poly: Polyhedron) -> list[tuple[NDArray[np.float64], NDArray[np.float64], float]]:
@@ -133,8 +158,8 @@ def face_contacts(bodies: Sequence[Body], *, gap_fraction: float = GAP_FRACTION)
         near = np.all((lo[j] <= hi[i] + limit[:, None]) & (hi[j] >= lo[i] - limit[:, None]), axis=1)
         near &= free[i] | free[j]
         for jj, lim in zip(j[near], limit[near]):
-            for va, na, oa in frames[i]:
-                for vb, nb, _ in frames[jj]:
+            for fa, (va, na, oa) in enumerate(frames[i]):
+                for fb, (vb, nb, _) in enumerate(frames[jj]):
                     if na @ nb > -cos_tol:
                         continue
                     gap = float(np.mean(vb @ na)) - oa
@@ -142,7 +167,7 @@ def face_contacts(bodies: Sequence[Body], *, gap_fraction: float = GAP_FRACTION)
                         continue
                     area = _overlap(va, vb, na)
                     if area > 1e-12 * max(thin[i], thin[jj]) ** 2:
-                        out.append(FaceContact(i, int(jj), na.copy(), area, gap))
+                        out.append(FaceContact(i, int(jj), na.copy(), area, gap, fa, fb))
     return out
 
 
@@ -155,6 +180,7 @@ class _Impact:
     normal: NDArray[np.float64]
     area: float
     partners: list[int]
+    contacts: list[FaceContact] = field(default_factory=list)
 
 
 def _sorted_pair(a: str, b: str) -> tuple[str, str]:
@@ -176,10 +202,115 @@ def _impacts(bodies: Sequence[Body], contacts: Sequence[FaceContact]) -> list[_I
                     imp.area += c.area
                     if other not in imp.partners:
                         imp.partners.append(other)
+                    imp.contacts.append(c)
                     break
             else:
-                out.append(_Impact(own, group, n, c.area, [other]))
+                out.append(_Impact(own, group, n, c.area, [other], [c]))
     return out
+
+
+TOUCH_FRACTION = 1e-3
+"""Facing faces further apart than this fraction of the smaller of the two blocks' smallest
+dimensions (reference pose) are *apart*; closer ones touch. Faces apart from their partner while the
+block touches a support in another direction strike by one edge row (module docstring)."""
+
+
+def _rocks_into(bodies: Sequence[Body], imp: _Impact, contacts: Sequence[FaceContact]) -> bool:
+    """Whether the impact's faces start apart from their partners while the block touches another
+    face in another direction (its support): rocking on that support closes the gap row by row."""
+    def touch(c: FaceContact) -> float:
+        thin = min(float(np.ptp(bodies[k].poly.vertices, axis=0).min()) for k in (c.a, c.b))
+        return TOUCH_FRACTION * thin
+    if not any(c.gap > touch(c) for c in imp.contacts):
+        return False
+    cos_tol = math.cos(math.radians(PARALLEL_TOL_DEG))
+    return any(imp.block in (c.a, c.b) and c.gap <= touch(c) and abs(float(c.normal @ imp.normal)) < cos_tol
+               for c in contacts)
+
+
+def _face_polygon(body: Body, face: int, u: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(k, 2) counter-clockwise polygon of a face in the plane coordinates (u, w)."""
+    v = body.poly.vertices[body.poly.faces[face]]
+    q = np.column_stack((v @ u, v @ w))
+    return q if _polygon_area(q) > 0 else q[::-1]
+
+
+def _inside(p: NDArray[np.float64], poly: NDArray[np.float64], tol: float) -> bool:
+    """Whether the 2D point p lies in the counter-clockwise convex polygon (tolerance tol [m])."""
+    e = np.roll(poly, -1, axis=0) - poly
+    cross = e[:, 0] * (p[1] - poly[:, 1]) - e[:, 1] * (p[0] - poly[:, 0])
+    return bool(np.all(cross >= -tol * np.hypot(e[:, 0], e[:, 1])))
+
+
+def _rows(q: NDArray[np.float64], tol: float) -> list[NDArray[np.int64]]:
+    """The points (indices) of each edge of the convex hull of the 2D points q (k, 2): the rows
+    that strike first when the face tilts about the opposite side."""
+    centred = q - q.mean(axis=0)
+    if len(q) >= 3 and np.linalg.matrix_rank(centred, tol=tol) == 2:
+        from scipy.spatial import ConvexHull  # noqa: PLC0415 - only for gap interfaces
+
+        outward = ConvexHull(q).equations[:, :2]
+    else:  # one point, or points on a line: its two ends
+        d = np.linalg.svd(centred)[2][0] if len(q) > 1 else np.array([1.0, 0.0])
+        outward = np.array([d, -d])
+    rows = {tuple(np.flatnonzero(q @ d >= (q @ d).max() - tol)) for d in outward}
+    return [np.array(r, dtype=np.int64) for r in sorted(rows)]
+
+
+def _row_strike(bodies: Sequence[Body], imp: _Impact) -> tuple[float, float] | None:
+    """(area A [m^2], effective mass m [kg]) of the stiffest single-row strike of an impact's faces.
+
+    The interface points of the smaller face of each facing pair that lie on the other face (within
+    half a cell) carry the contact with their tributary areas (scaled down to the pair's overlap
+    area where they exceed it). A block rocking about another
+    interface (its base) closes the gap with one edge row of these points first; during the strike
+    its base friction (mu m g) is far below the impact force, so the block is free and the row's
+    effective mass is 1 / m_eff = 1 / m + (r x n) . I^-1 (r x n) (r from the centre of mass to the
+    row's centroid; plus the same term of a single free partner, or 1 / M of several).
+    None when no points are known.
+    """
+    own = bodies[imp.block]
+    n = imp.normal
+    u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])  # plane coordinates (u, w) normal to n
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    pts, areas, owner = [], [], []
+    for c in imp.contacts:
+        faces = [(bodies[c.a], c.face_a, bodies[c.b], c.face_b), (bodies[c.b], c.face_b, bodies[c.a], c.face_a)]
+        faces.sort(key=lambda f: abs(_polygon_area(_face_polygon(f[0], f[1], u, w))))  # the smaller face's points
+        carrier, face, other, other_face = faces[0]
+        sel = np.flatnonzero(carrier.point_faces == face)
+        if len(sel) == 0:
+            return None
+        poly = _face_polygon(other, other_face, u, w)
+        on = [i for i in sel  # within half a cell of the other face: its cell is (mostly) covered
+              if _inside(np.array([carrier.points[i] @ u, carrier.points[i] @ w]), poly, 0.5 * math.sqrt(carrier.point_areas[i]))]
+        if not on:
+            continue
+        a = carrier.point_areas[on]
+        pts.append(carrier.points[on])
+        areas.append(a * min(1.0, c.area / a.sum()))
+        owner += [c.b if c.a == imp.block else c.a] * len(on)
+    if not pts:
+        return None
+    p, a, part = np.vstack(pts), np.concatenate(areas), np.array(owner)
+    size = float(np.ptp(p, axis=0).max()) or 1.0
+
+    def flexibility(body: Body, r: NDArray[np.float64]) -> float:
+        arm = np.cross(r - body.centre, n)
+        return 1.0 / body.mass + float(arm @ np.linalg.solve(body.inertia, arm))
+
+    best: tuple[float, float] | None = None
+    for row in _rows(np.column_stack((p @ u, p @ w)), 1e-6 * size):
+        area = float(a[row].sum())
+        r = (a[row] @ p[row]) / area
+        flex = flexibility(own, r)
+        struck = [bodies[j] for j in np.unique(part[row])]
+        if all(b.free for b in struck):
+            flex += flexibility(struck[0], r) if len(struck) == 1 else 1.0 / sum(b.mass for b in struck)
+        if best is None or area * flex > best[0] / best[1]:
+            best = (area, 1.0 / flex)
+    return best
 
 
 def model_bodies(model) -> list[Body]:  # noqa: ANN001 - a rockdem.model.Model (imported lazily by callers)
@@ -203,8 +334,12 @@ def model_bodies(model) -> list[Body]:  # noqa: ANN001 - a rockdem.model.Model (
         nrm = np.array(normals)
         offsets = np.array([nrm[k] @ v[f[0]] for k, f in enumerate(faces)])
         poly = Polyhedron(v, faces, nrm, offsets)
+        pts = np.flatnonzero(m.point_block == b)
         out.append(Body(model.block_names[b], model.group_names[int(m.block_group[b])], poly,
-                        float(m.block_mass[b]), bool(m.block_free[b])))
+                        float(m.block_mass[b]), bool(m.block_free[b]), centre=np.array(model.position_ref[b], dtype=float),
+                        inertia=rot[b] @ np.diag(m.block_inertia[b]) @ rot[b].T,
+                        points=m.point_local[pts] @ rot[b].T + model.position_ref[b], point_areas=m.point_area[pts].copy(),
+                        point_faces=m.point_face[pts] - int(m.block_face_start[b])))
     return out
 
 
@@ -244,7 +379,7 @@ def critical_pair_betas(
         raise ValueError(f"damping.damping_ratio must be a positive number (1 = critical), got {damping_ratio!r}")
     if contacts is None:
         contacts = face_contacts(bodies, gap_fraction=gap_fraction)
-    best: dict[tuple[str, str], tuple[float, float, float, float, tuple[str, str]]] = {}
+    best: dict[tuple[str, str], tuple[float, float, float, float, tuple[str, str], str]] = {}
     for imp in _impacts(bodies, contacts):
         own = bodies[imp.block]
         partners = [bodies[j] for j in imp.partners]
@@ -255,9 +390,13 @@ def critical_pair_betas(
             mass = own.mass
         key = _sorted_pair(own.group, imp.group)
         k = kn(own.group, imp.group)
-        omega = math.sqrt(k * imp.area / mass)
+        omega, area, what = math.sqrt(k * imp.area / mass), imp.area, "landing flat"
+        strike = _row_strike(bodies, imp) if _rocks_into(bodies, imp, contacts) else None
+        if strike is not None and k * strike[0] / strike[1] > omega * omega:
+            area, mass = strike
+            omega, what = math.sqrt(k * area / mass), "striking with one edge row of its points (a gap closed by rocking)"
         if key not in best or omega > best[key][0]:
-            best[key] = (omega, imp.area, mass, k, (own.name, " + ".join(p.name for p in partners)))
+            best[key] = (omega, area, mass, k, (own.name, " + ".join(p.name for p in partners)), what)
     groups = sorted({b.group for b in bodies})
     out: dict[tuple[str, str], PairBeta] = {}
     for i, ga in enumerate(groups):
@@ -266,9 +405,9 @@ def critical_pair_betas(
             members = [b for b in bodies if b.group in key]
             free = [b for b in members if b.free]
             if key in best:
-                omega, area, mass, k, names = best[key]
+                omega, area, mass, k, names, what = best[key]
                 how = (f"omega = sqrt(kn A / m) = sqrt({k:.4g} Pa/m x {area:.4g} m^2 / {mass:.4g} kg) = {omega:.5g} rad/s "
-                       f"({names[0]} on {names[1]}); beta = 2 zeta / omega, zeta = {damping_ratio:g}")
+                       f"({names[0]} on {names[1]}, {what}); beta = 2 zeta / omega, zeta = {damping_ratio:g}")
             elif free and (ga != gb or len(members) > 1):
                 # no interface at the start: the lightest free block of the pair landing on its largest face
                 blk = min(free, key=lambda x: x.mass)

@@ -227,14 +227,15 @@ def test_advisor_targets_the_restitution_and_says_which_beta_and_why(capsys: pyt
 
 
 def test_advisor_per_interface_betas_of_a_one_sided_facade(capsys: pytest.CaptureFixture[str]) -> None:
-    # each pair beta = 2 zeta / omega, omega = sqrt(kn A / m) with kn = E / H (paper Eq. 1-4, §2.2):
-    # the base (B x L) and both return walls' end faces (2 x 0.11 m x H, the façade builder's walls)
+    # each pair beta = 2 zeta / omega with kn = E / H (paper Eq. 1-4, §2.2): the base landing flat,
+    # omega = sqrt(kn A / m) (B x L); the return walls (end faces 2 x 0.11 m x H) struck across the gap
+    # by their top row of points (A / 2) on the free façade, 1 / m_eff = (1 + 3 H^2 / (B^2 + H^2)) / m
     adv = advise(**FACADE, configuration="one-sided", per_interface=True)
     c = adv.beta_choice
     m, kn = 1750 * 0.11 * 0.8 * 1.5, 1.8e9 / 0.8
     base, ret = c.pair("facade", "foundation"), c.pair("facade", "return")
     assert base.beta == pytest.approx(2 / math.sqrt(kn * 0.11 * 1.5 / m), rel=1e-9)
-    assert ret.beta == pytest.approx(2 / math.sqrt(kn * 2 * 0.11 * 0.8 / m), rel=1e-9)
+    assert ret.beta == pytest.approx(2 / math.sqrt(kn * 0.11 * 0.8 * (1 + 3 * 0.64 / (0.0121 + 0.64)) / m), rel=1e-9)
     assert adv.recommended_beta == max(base.beta, ret.beta)
     assert "sqrt(kn A / m)" in base.how and "per interface" in adv.recommended_why.lower()
     text = adv.table()
