@@ -17,18 +17,23 @@ import threading
 import warnings
 from collections.abc import Callable, Iterator
 
-# Modules that contribute a sub-command through ``register_cli(subparsers)``.
-_COMMAND_MODULES = (
-    "rockdem.run_cli",
-    "rockdem.preview",
-    "rockdem.records",
-    "rockdem.advisor",
-    "rockdem.plots",
-    "rockdem.animate",
-    "rockdem.vtk_export",
-    "rockdem.studies",
-    "rockdem.reproduce",
-)
+# The module that contributes each sub-command through ``register_cli(subparsers)``: a command line
+# naming a command imports only its module (``rockdem run`` does not load Matplotlib or SciPy's
+# signal package); ``rockdem --help`` and unknown commands import them all.
+_COMMANDS = {
+    "run": "rockdem.run_cli",
+    "show": "rockdem.preview",
+    "records": "rockdem.records",
+    "advise": "rockdem.advisor",
+    "plot": "rockdem.plots",
+    "animate": "rockdem.animate",
+    "export": "rockdem.vtk_export",
+    "sweep": "rockdem.studies",
+    "calibrate": "rockdem.studies",
+    "fragility": "rockdem.studies",
+    "reproduce": "rockdem.reproduce",
+}
+_COMMAND_MODULES = tuple(dict.fromkeys(_COMMANDS.values()))
 
 EXIT_BAD_INPUT = 2
 EXIT_DIVERGED = 3
@@ -146,8 +151,8 @@ non_negative_float = _number("non-negative")
 positive_int = integer_at_least(1)
 
 
-def _add_commands(sub: argparse._SubParsersAction) -> None:
-    for name in _COMMAND_MODULES:
+def _add_commands(sub: argparse._SubParsersAction, modules: tuple[str, ...]) -> None:
+    for name in modules:
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError as exc:
@@ -159,8 +164,8 @@ def _add_commands(sub: argparse._SubParsersAction) -> None:
             register(sub)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The top-level parser with every registered sub-command."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The top-level parser: with a known ``command``, that command only; otherwise every one."""
     from . import __version__
 
     parser = argparse.ArgumentParser(
@@ -172,13 +177,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"rockdem {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    _add_commands(sub)
+    _add_commands(sub, (_COMMANDS[command],) if command in _COMMANDS else _COMMAND_MODULES)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``rockdem`` console script; returns the exit status (see the module)."""
-    parser = build_parser()
+    words = sys.argv[1:] if argv is None else argv
+    parser = build_parser(next((w for w in words if not w.startswith("-")), None))  # top-level flags take no value
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: --help, --version (0) or a bad flag (2, message printed)

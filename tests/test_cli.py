@@ -175,6 +175,16 @@ def test_command_modules_without_a_command_are_skipped(monkeypatch):
     assert "run" in parser._subparsers._group_actions[0].choices
 
 
+def test_each_command_comes_from_the_module_named_for_it():
+    # ``rockdem CMD`` imports only CMD's module: the table must name every command and its module
+    import rockdem.cli
+
+    every = set(rockdem.cli.build_parser()._subparsers._group_actions[0].choices)
+    assert every == set(rockdem.cli._COMMANDS)
+    for command in every:
+        assert command in rockdem.cli.build_parser(command)._subparsers._group_actions[0].choices
+
+
 def test_citation_file_matches_the_package_and_cites_the_paper():
     from pathlib import Path
 
