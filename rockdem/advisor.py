@@ -15,7 +15,8 @@ B (rocking direction), height H and length L:
 * eta = atan(B/H), semi-diagonal R, eta/R with a bouncing warning above 45 deg/m (§3.1);
 * Housner e_eta = 1 - 1.5 sin^2 eta and 0.95 e_eta (§3.2.1);
 * stable timesteps for MP and SP runs and the expected SP/MP cost ratio (central differences,
-  with Belytschko's reduction for SP damping); only these depend on the length L;
+  with Belytschko's reduction for SP damping with explicit dashpots, 3DEC's scheme; the default
+  implicit dashpots keep the MP step, docs/dashpots.md); only these depend on the length L;
 * on request, the beta of the model itself (a block, a stack or a one-sided façade with these
   inputs, built with :mod:`rockdem.specimens`): targeted to a restitution (``target_restitution``:
   short free-rocking runs, :mod:`rockdem.targeting`) and/or per joint group pair from each pair's
@@ -178,8 +179,9 @@ class Advice:
     e_eta_95: float = _out("-", "§3.2.1: 0.95 e_eta (closer to experiments)", "0.95 e_eta")
     omega_max: float = _out("rad/s", "Gershgorin bound of the sub-contact springs (estimate; depends on L)", "omega_max")
     dt_mp: float = _out("s", "central differences: 0.9 x 2 / omega_max", "dt, MP or no damping")
-    dt_sp: float = _out("s", "Belytschko: 0.9 x 2/omega_max x (sqrt(1+xi^2) - xi), xi = beta omega_max / 2", "dt, SP")
-    cost_ratio: float = _out("-", "dt_MP / dt_SP", "expected SP/MP cost")
+    dt_sp: float = _out("s", "Belytschko: 0.9 x 2/omega_max x (sqrt(1+xi^2) - xi), xi = beta omega_max / 2 (implicit: dt_MP)",
+                        "dt, SP explicit dashpots")
+    cost_ratio: float = _out("-", "dt_MP / dt_SP (1 with the default implicit dashpots)", "SP/MP cost, explicit")
     dt_3dec_mp: float = _out("s", "§3: 0.2 sqrt(m_min / k_max)", "dt 3DEC rule, MP")
     dt_3dec_sp: float = _out("s", "§3 + Belytschko: 3DEC dt x SP reduction", "dt 3DEC rule, SP")
     cost_ratio_3dec: float = _out("-", "dt_3DEC_MP / dt_3DEC_SP", "SP/MP cost, 3DEC rule")
@@ -494,7 +496,8 @@ def _recommendations(
         f"Use SP damping (alpha = 0, beta = {beta:.3g} s) for collapse and overturning studies and "
         "earthquake rocking: it was consistent with every experiment simulated (§5).",
         f"MP damping (alpha ~ {alpha_mp:.3g} 1/s, §4.3) only as a fast first approximation "
-        f"(SP needs {cost:.2g}x more steps here by the engine's bound), to be refined with SP: small changes of alpha changed "
+        f"(with rockdem's default implicit dashpots SP takes the MP step; with explicit dashpots, 3DEC's scheme, it needs "
+        f"{cost:.2g}x more steps here), to be refined with SP: small changes of alpha changed "
         "the whole history and the overturning (§4.1, §5).",
     ]
     if i.configuration is Configuration.ONE_SIDED:
