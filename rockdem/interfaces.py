@@ -1,8 +1,9 @@
 """The interfaces of a model and the critical SP damping of each joint group pair (paper Eq. 1-4, §2.2).
 
-An *interface* is a pair of facing faces of two blocks, at least one free: antiparallel outward
-normals, planes at most a gap apart (touching joints, or the few millimetres between a one-sided
-façade and its return walls) and an overlap of positive area A, in the reference (untilted) pose.
+An *interface* is a pair of facing faces of two blocks, at least one free: outward normals
+antiparallel within 10 deg, at most a gap apart at their closest (touching joints, or the few
+millimetres between a one-sided façade and its return walls) and an overlap of positive area A,
+in the reference (untilted) pose.
 
 **Critical impact of an interface.** A face of area A landing flat on its partner compresses all
 its sub-contact springs at once (faces of a block facing the same direction and the same partner
@@ -62,7 +63,11 @@ smaller of the two blocks' smallest dimensions (a façade 0.11 m thick: 11 mm; S
 gap to the return walls is inside it)."""
 
 PARALLEL_TOL_DEG = 2.0
-"""Facing faces: outward normals antiparallel within this angle [deg]."""
+"""Faces of one block striking together: outward normals parallel within this angle [deg]."""
+
+FACING_TOL_DEG = 10.0
+"""Facing faces: outward normals antiparallel within this angle [deg] (a façade leaned outward on a
+sloped foundation still strikes its vertical return walls: it turns parallel to them on the way)."""
 
 
 @dataclass(frozen=True)
@@ -98,7 +103,7 @@ class FaceContact:
     Attributes:
         normal: (3,) outward unit normal of a's face (from a towards b).
         area: overlap area of the two faces [m^2].
-        gap: distance between the two face planes [m] (negative: overlapping).
+        gap: closest distance of b's face from a's face plane [m] (negative: overlapping).
         face_a, face_b: the two faces, indices into ``poly.faces`` of a and b.
     """
 
@@ -149,7 +154,7 @@ def face_contacts(bodies: Sequence[Body], *, gap_fraction: float = GAP_FRACTION)
     hi = np.array([b.poly.vertices.max(axis=0) for b in bodies])
     thin = (hi - lo).min(axis=1)
     free = np.array([b.free for b in bodies], dtype=bool)
-    cos_tol = math.cos(math.radians(PARALLEL_TOL_DEG))
+    cos_tol = math.cos(math.radians(FACING_TOL_DEG))
     frames = [_face_frames(b.poly) for b in bodies]
     out: list[FaceContact] = []
     for i in range(len(bodies)):
@@ -162,7 +167,7 @@ def face_contacts(bodies: Sequence[Body], *, gap_fraction: float = GAP_FRACTION)
                 for fb, (vb, nb, _) in enumerate(frames[jj]):
                     if na @ nb > -cos_tol:
                         continue
-                    gap = float(np.mean(vb @ na)) - oa
+                    gap = float(np.min(vb @ na)) - oa  # closest approach (the mean for parallel faces)
                     if abs(gap) > lim:
                         continue
                     area = _overlap(va, vb, na)
