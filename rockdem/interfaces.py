@@ -52,7 +52,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .beta_choice import PairBeta
-from .geometry import Polyhedron, _clip, _polygon_area
+from .geometry import Polyhedron, _clip, _inside_2d, _polygon_area
 from .kernels.rotation import quats_to_matrices
 
 __all__ = ["Body", "FaceContact", "GAP_FRACTION", "face_contacts", "model_bodies", "critical_pair_betas", "critical_betas"]
@@ -121,19 +121,19 @@ def _face_frames(poly: Polyhedron) -> list[tuple[NDArray[np.float64], NDArray[np
     return [(poly.vertices[f], poly.normals[i], float(poly.offsets[i])) for i, f in enumerate(poly.faces)]
 
 
+def _ccw(v: NDArray[np.float64], u: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
+    """(k, 2) counter-clockwise polygon of the face vertices v (k, 3) in the plane coordinates (u, w)."""
+    q = np.column_stack((v @ u, v @ w))
+    return q if _polygon_area(q) > 0 else q[::-1]
+
+
 def _overlap(va: NDArray[np.float64], vb: NDArray[np.float64], n: NDArray[np.float64]) -> float:
     """Area [m^2] of the overlap of two facing convex polygons (k, 3), projected on the plane of normal n."""
     u = va[1] - va[0]
     u = u - n * (n @ u)
     u /= np.linalg.norm(u)
     w = np.cross(n, u)
-    pa = np.column_stack((va @ u, va @ w))
-    pb = np.column_stack((vb @ u, vb @ w))
-    if _polygon_area(pa) < 0:
-        pa = pa[::-1]
-    if _polygon_area(pb) < 0:  # b's face runs counter-clockwise about -n
-        pb = pb[::-1]
-    clipped = _clip(pa, pb)
+    clipped = _clip(_ccw(va, u, w), _ccw(vb, u, w))  # b's face runs counter-clockwise about -n: reoriented
     return abs(_polygon_area(clipped)) if len(clipped) >= 3 else 0.0
 
 
@@ -220,31 +220,17 @@ dimensions (reference pose) are *apart*; closer ones touch. Faces apart from the
 block touches a support in another direction strike by one edge row (module docstring)."""
 
 
-def _rocks_into(bodies: Sequence[Body], imp: _Impact, contacts: Sequence[FaceContact]) -> bool:
+def _rocks_into(imp: _Impact, own_contacts: Sequence[FaceContact], thin: NDArray[np.float64]) -> bool:
     """Whether the impact's faces start apart from their partners while the block touches another
-    face in another direction (its support): rocking on that support closes the gap row by row."""
-    def touch(c: FaceContact) -> float:
-        thin = min(float(np.ptp(bodies[k].poly.vertices, axis=0).min()) for k in (c.a, c.b))
-        return TOUCH_FRACTION * thin
-    if not any(c.gap > touch(c) for c in imp.contacts):
+    face in another direction (its support): rocking on that support closes the gap row by row.
+    ``own_contacts``: the facing faces of the impact's block; ``thin``: (nb,) each block's smallest
+    dimension [m]."""
+    def apart(c: FaceContact) -> bool:
+        return c.gap > TOUCH_FRACTION * min(thin[c.a], thin[c.b])
+    if not any(apart(c) for c in imp.contacts):
         return False
     cos_tol = math.cos(math.radians(PARALLEL_TOL_DEG))
-    return any(imp.block in (c.a, c.b) and c.gap <= touch(c) and abs(float(c.normal @ imp.normal)) < cos_tol
-               for c in contacts)
-
-
-def _face_polygon(body: Body, face: int, u: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
-    """(k, 2) counter-clockwise polygon of a face in the plane coordinates (u, w)."""
-    v = body.poly.vertices[body.poly.faces[face]]
-    q = np.column_stack((v @ u, v @ w))
-    return q if _polygon_area(q) > 0 else q[::-1]
-
-
-def _inside(p: NDArray[np.float64], poly: NDArray[np.float64], tol: float) -> bool:
-    """Whether the 2D point p lies in the counter-clockwise convex polygon (tolerance tol [m])."""
-    e = np.roll(poly, -1, axis=0) - poly
-    cross = e[:, 0] * (p[1] - poly[:, 1]) - e[:, 1] * (p[0] - poly[:, 0])
-    return bool(np.all(cross >= -tol * np.hypot(e[:, 0], e[:, 1])))
+    return any(not apart(c) and abs(float(c.normal @ imp.normal)) < cos_tol for c in own_contacts)
 
 
 def _rows(q: NDArray[np.float64], tol: float) -> list[NDArray[np.int64]]:
@@ -267,8 +253,8 @@ def _row_strike(bodies: Sequence[Body], imp: _Impact) -> tuple[float, float] | N
 
     The interface points of the smaller face of each facing pair that lie on the other face (within
     half a cell) carry the contact with their tributary areas (scaled down to the pair's overlap
-    area where they exceed it). A block rocking about another
-    interface (its base) closes the gap with one edge row of these points first; during the strike
+    area where they exceed it). A block rocking about another interface (its base) closes the gap
+    with one edge row of these points first; during the strike
     its base friction (mu m g) is far below the impact force, so the block is free and the row's
     effective mass is 1 / m_eff = 1 / m + (r x n) . I^-1 (r x n) (r from the centre of mass to the
     row's centroid; plus the same term of a single free partner, or 1 / M of several).
@@ -282,14 +268,14 @@ def _row_strike(bodies: Sequence[Body], imp: _Impact) -> tuple[float, float] | N
     pts, areas, owner = [], [], []
     for c in imp.contacts:
         faces = [(bodies[c.a], c.face_a, bodies[c.b], c.face_b), (bodies[c.b], c.face_b, bodies[c.a], c.face_a)]
-        faces.sort(key=lambda f: abs(_polygon_area(_face_polygon(f[0], f[1], u, w))))  # the smaller face's points
+        faces.sort(key=lambda f: abs(_polygon_area(_ccw(f[0].poly.vertices[f[0].poly.faces[f[1]]], u, w))))  # the smaller face's points
         carrier, face, other, other_face = faces[0]
         sel = np.flatnonzero(carrier.point_faces == face)
         if len(sel) == 0:
             return None
-        poly = _face_polygon(other, other_face, u, w)
+        poly = _ccw(other.poly.vertices[other.poly.faces[other_face]], u, w)
         on = [i for i in sel  # within half a cell of the other face: its cell is (mostly) covered
-              if _inside(np.array([carrier.points[i] @ u, carrier.points[i] @ w]), poly, 0.5 * math.sqrt(carrier.point_areas[i]))]
+              if _inside_2d(np.array([carrier.points[i] @ u, carrier.points[i] @ w]), poly, 0.5 * math.sqrt(carrier.point_areas[i]))]
         if not on:
             continue
         a = carrier.point_areas[on]
@@ -384,6 +370,11 @@ def critical_pair_betas(
         raise ValueError(f"damping.damping_ratio must be a positive number (1 = critical), got {damping_ratio!r}")
     if contacts is None:
         contacts = face_contacts(bodies, gap_fraction=gap_fraction)
+    thin = np.array([float(np.ptp(b.poly.vertices, axis=0).min()) for b in bodies])
+    by_block: dict[int, list[FaceContact]] = {}
+    for c in contacts:
+        by_block.setdefault(c.a, []).append(c)
+        by_block.setdefault(c.b, []).append(c)
     best: dict[tuple[str, str], tuple[float, float, float, float, tuple[str, str], str]] = {}
     for imp in _impacts(bodies, contacts):
         own = bodies[imp.block]
@@ -396,7 +387,7 @@ def critical_pair_betas(
         key = _sorted_pair(own.group, imp.group)
         k = kn(own.group, imp.group)
         omega, area, what = math.sqrt(k * imp.area / mass), imp.area, "landing flat"
-        strike = _row_strike(bodies, imp) if _rocks_into(bodies, imp, contacts) else None
+        strike = _row_strike(bodies, imp) if _rocks_into(imp, by_block[imp.block], thin) else None
         if strike is not None and k * strike[0] / strike[1] > omega * omega:
             area, mass = strike
             omega, what = math.sqrt(k * area / mass), "striking with one edge row of its points (a gap closed by rocking)"
