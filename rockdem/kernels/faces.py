@@ -202,7 +202,7 @@ def _cell_to_target(cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.nda
 def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
-    lumped: bool,
+    lumped: bool, target_cell_area: float,
 ) -> tuple[float, float, float, float]:
     """Effective area, force point (u, w) and depth shift of a cell the target polygon does not
     wholly cover.
@@ -223,7 +223,10 @@ def partly_covered(
     corner or edge landing near the partner's edge is as stiff as the same corner landing in the
     middle of the face (the paper's interface point carries its whole tributary area), and the
     stiffness still falls continuously to zero as the overlapping part leaves the partner. Where the
-    whole cell overlaps (a flat joint) this is the covered area itself.
+    whole cell overlaps (a flat joint) this is the covered area itself. The lumped area is at most
+    ``target_cell_area`` [m^2] (the mean cell of the target face) or the covered area, whichever is
+    larger: a big cell whose sliver presses on a small face (a wall face on a 20 mm rod) is as stiff
+    as the small face's own interface point, as an EDGE pair is as stiff as the smaller side's.
     """
     nv = _cell_to_target(cell_start, cell_vertex, buf, p, fm)
     xu = fm.m00 * nu + fm.m01 * nw + fm.t0
@@ -278,7 +281,7 @@ def partly_covered(
             yu = inv * (fm.m11 * tu - fm.m01 * tw)  # back to owner coordinates
             yw = inv * (-fm.m10 * tu + fm.m00 * tw)
         if lumped:
-            area = _lumped_area(cell_start, cell_vertex, buf, cur, n, point_area, area, p, fm, gu, gw)
+            area = max(area, min(_lumped_area(cell_start, cell_vertex, buf, cur, n, point_area, area, p, fm, gu, gw), target_cell_area))
     return area, yu, yw, shift
 
 
@@ -319,5 +322,5 @@ def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float
         return 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
     return partly_covered(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False,
+        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False, np.inf,
     )

@@ -188,7 +188,7 @@ def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
         area, yu, yw, shift = partly_covered(
             m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
             m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0,
-            not s.slot_bonded[p, code - SLOTS * p],
+            not s.slot_bonded[p, code - SLOTS * p], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
         )
         sc.track_area[k] = area
         sc.track_point_u[k] = yu

@@ -268,10 +268,7 @@ def _comment(ft: pd.DataFrame, qt: pd.DataFrame) -> str:
             "**Engine problem**: energy created (share of the run's energy scale) in "
             + "; ".join([f"free rocking, {r.model}: {100 * r['energy created / scale']:.1f} %" for _, r in bad_free.iterrows()]
                         + [f"{r.record}, {r.model}: {100 * r['energy created / scale']:.1f} %" for _, r in bad_quake.iterrows()])
-            + ". In the free-rocking runs most of it appears while the pushing rod holds and withdraws (the measure spans the whole "
-            "run, push included); under the records it appears at large rotations: in Pacoima with MP (examined) the top "
-            "block, turned 15 degrees, bears on a restraining rod's 20 mm face with its face cells of 0.475 x 0.375 m, whose "
-            "lumped areas jump at millimetres of depth, and the springs' energy with them (docs/contacts.md, section 5)."
+            + " (docs/contacts.md, section 5, lists the known causes)."
         )
     return " ".join(lines)
 
@@ -295,14 +292,10 @@ def _notes(qt: pd.DataFrame, reduced: bool) -> str:
   back from beyond it, so "collapsed" means that it ends beyond it.
 - "Energy created": the largest rise of kinetic + potential + elastic energy beyond the work done on the model, over
   the run's energy scale (`rockdem.results.energy_check`); above 1 % it is reported as an engine problem.
-- Energy check, examined by hand on two runs: (1) free rocking, no damping: kinetic + potential + elastic energy
-  minus the driven rods' work rises by 1.1 J (of the 14.7 J the pushing rod puts in) between 1.0 and 1.5 s, while
-  the rod holds and withdraws at 1 m/s, and by up to 0.7 J within half-second windows after the release (about
-  5 % of the mechanical energy); (2) Nahanni x 1 (0-6 s of the record), SP beta = 0.0032, in foundation and in
-  inertial mode alike (so not the rods' work bookkeeping): at 6.39-6.44 s, both blocks rotated by 0.2 rad (mid-height
-  displacement about 1.4 B), the active sub-contacts go from 8 to 10 and the elastic energy jumps from 3.1 to
-  10.7 J in 50 ms: the mechanical energy rises by 6.4 J (6 % of the run's energy scale). MP alpha = 0.7539 under the
-  same window: 18.5 J (11 %) at 3.82-3.85 s.
+- Energy check: before the lumped areas of sub-contacts were capped at the cell of the face pressed on
+  (docs/contacts.md, sections 2 and 5), the wall's 0.475 x 0.375 m face cells, lumped onto a restraining rod's
+  20 mm face, created 19-20 % of the energy scale under Pacoima x 0.8 and Nahanni x 1 with MP damping, and 2-5 %
+  in the other runs; the table above is after the cap.
 - Records: El Centro 1940 (PEER RSN6, comp. 180) x 0.66, Pacoima Dam 1971 (RSN77, comp. 164) x 0.80, Nahanni 1985
   (Site 1, comp. 280) x 1.00, the shipped files (the paper's processing is not given), foundation-mode input (the rods
   follow the ground), {QUAKE_TAIL:g} s tail; WME over the whole run (no cut).
