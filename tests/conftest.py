@@ -2,17 +2,8 @@
 
 from __future__ import annotations
 
-import os
-
-import numba
 import numpy as np
 import pytest
-
-# One Numba thread for the suite (and its subprocesses): the runs use the serial kernel variant,
-# compiled once, as before; tests/test_parallel.py asks for two threads itself and compiles the
-# parallel variant (about 5 minutes, once) to compare the two bit for bit.
-numba.set_num_threads(1)
-os.environ["NUMBA_NUM_THREADS"] = "1"
 
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
