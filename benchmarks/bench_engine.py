@@ -6,7 +6,7 @@
     paper's pragmatic relation); wall time after compilation and the SP/MP ratio.
     3DEC (paper Table 2): 6, 13, 16, 20, 34, 54 hours; SP/MP 50 to 350 (§3.1).
 (b) A stack-bond wall of >= 1000 bricks settling under gravity: sub-contact updates per second
-    on one thread and on all of Numba's threads (NUMBA_NUM_THREADS), with the results compared.
+    on one core.
 (c) Cold start: ``rockdem run --example free-rocking`` with an empty Numba cache, then warm.
 """
 
@@ -17,9 +17,6 @@ import subprocess
 import sys
 import tempfile
 import time
-
-import numba
-import numpy as np
 
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
@@ -67,19 +64,11 @@ def bench_wall(courses: int = 40, per_course: int = 25) -> None:
     model = b.finalize(damping=Damping(alpha=5.0))
     s, _ = initial_state(model)
     tracked = int(s.track_count[0])
-    print(f"(b) wall of {courses * per_course} bricks, {tracked} tracked sub-contacts, 0.05 s")
-    first = {}
-    for threads in sorted({1, numba.config.NUMBA_NUM_THREADS}):
-        numba.set_num_threads(threads)
-        simulate(model, 1e-3, progress=False)  # compile
-        ds = simulate(model, 0.05, record_interval=0.01, progress=False)
-        steps, runtime = ds.attrs["steps"], ds.attrs["runtime_s"]
-        rate = tracked * steps / runtime
-        first.setdefault("rate", rate)
-        first.setdefault("ds", ds)
-        same = all(np.array_equal(ds[v].values, first["ds"][v].values, equal_nan=True) for v in ds.data_vars if ds[v].dtype.kind == "f")
-        print(f"    {threads} thread(s): {steps} steps in {runtime:.2f} s, sub-contact updates per second {rate:.3e} "
-              f"({rate / first['rate']:.2f}x one thread; same results: {same})")
+    simulate(model, 1e-3, progress=False)  # compile
+    ds = simulate(model, 0.05, record_interval=0.01, progress=False)
+    steps, runtime = ds.attrs["steps"], ds.attrs["runtime_s"]
+    print(f"(b) wall of {courses * per_course} bricks, {tracked} tracked sub-contacts, {steps} steps in {runtime:.2f} s")
+    print(f"    sub-contact updates per second (1 core): {tracked * steps / runtime:.3e}")
 
 
 def bench_cold_start() -> None:
@@ -93,6 +82,7 @@ def bench_cold_start() -> None:
 
 
 if __name__ == "__main__":
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
     which = sys.argv[1:] or ["table2", "wall", "cold"]
     if "table2" in which:
         bench_table2()

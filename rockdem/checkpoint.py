@@ -47,9 +47,8 @@ from .timestep import TimestepInfo
 __all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
-FORMAT_VERSION = 2
-"""Version of the checkpoint file layout; a file of another version is refused (2: per-pair and
-per-thread scratch of the parallel force passes)."""
+FORMAT_VERSION = 1
+"""Version of the checkpoint file layout; a file of another version is refused."""
 
 LOADING_FIELDS = frozenset(
     {"block_motion", "motion_start", "motion_time", "motion_velocity", "ground_motion", "body_time",
@@ -57,10 +56,6 @@ LOADING_FIELDS = frozenset(
 )
 """ModelArrays fields that describe the loading and damping, not the blocks: a checkpoint with its
 clock reset may start a model that differs in these (every other field must match)."""
-
-_PER_THREAD = ("poly",)
-"""Scratch buffers sized by the thread count and holding nothing between steps: taken fresh on
-resume (the checkpoint may come from a machine with another number of cores)."""
 
 PathLike = str | os.PathLike[str]
 
@@ -267,15 +262,12 @@ class Checkpoint:
         fresh_s, fresh_sc = initial_state(model, check_overlap=False)
         for saved, ref in ((self.state, fresh_s), (self.scratch, fresh_sc)):
             for name, a, b in zip(ref._fields, saved, ref):
-                if name in _PER_THREAD:
-                    continue
                 ok = a.dtype == b.dtype and a.ndim == b.ndim and a.shape[1:] == b.shape[1:] and (
                     a.shape[:1] == b.shape[:1] or (a.ndim and a.shape[0] >= b.shape[0]))
                 if not ok:
                     raise ValueError(f"checkpoint {type(ref).__name__}.{name} has dtype {a.dtype} shape {a.shape}, "
                                      f"this model needs {b.dtype} {b.shape}: the checkpoint belongs to another model")
-        scratch = _copy(self.scratch)._replace(**{name: getattr(fresh_sc, name) for name in _PER_THREAD})
-        return _copy(self.state), scratch
+        return _copy(self.state), _copy(self.scratch)
 
 
 def _names(names: tuple[str, ...], n: int = 6) -> str:

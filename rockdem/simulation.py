@@ -37,13 +37,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
-import numba
 import numpy as np
 import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
-from .kernels.forces import PARALLEL
 from .kernels.step import DIVERGENCE_ERROR, advance
 from .model import Model
 from .results import block_thickness, build_dataset
@@ -69,10 +67,6 @@ _MAX_RECORD_BYTES = 2 * 1024**3
 
 DEFAULT_MAX_STEPS = 1_000_000_000
 """Largest number of steps a run may need before it is refused (raise it with ``max_steps``)."""
-
-PARALLEL_BLOCKS = 24
-"""Blocks from which a run uses the parallel kernel variant (its contact passes go parallel once
-the model has ``kernels.forces.PARALLEL_PAIRS`` contact pairs)."""
 
 
 def simulate(
@@ -252,9 +246,6 @@ def run_model(
     target = run.check_target if stopper is not None else None
     if stopper is not None and frame > 0 and target is None:
         decision = stopper.check(rec, frame)  # a continued run: the saved frames may decide it already
-    # Models with many blocks compile and use the kernel variant whose contact passes run on the
-    # Numba threads (NUMBA_NUM_THREADS=1 keeps every run serial); results do not depend on it.
-    how = PARALLEL if model.block_count >= PARALLEL_BLOCKS and numba.get_num_threads() > 1 else None
     kernel = 0.0
     bar = None
     interrupted = False
@@ -271,8 +262,7 @@ def run_model(
                 else:
                     t_stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
                 t0 = _time.perf_counter()
-                scratch.threads[0] = numba.get_num_threads()
-                frame, status = advance(m, state, scratch, t_stop, run.record_interval, rec, frame, how)
+                frame, status = advance(m, state, scratch, t_stop, run.record_interval, rec, frame)
                 elapsed = _time.perf_counter() - t0
                 kernel += elapsed
                 if status == STATUS_GROW:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from .kernels.detect import detect, update_rotations
@@ -42,13 +41,6 @@ def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
         "pair_dashpot_cn": np.zeros(count),
         "pair_dashpot_cs": np.zeros(count),
         "pair_dashpot_velocity": np.zeros((count, 3)),
-        "pair_partial": np.zeros(count, dtype=i64),
-        "pair_released": np.zeros(count, dtype=i64),
-        "pair_failed": np.zeros(count, dtype=i64),
-        "pair_elastic": np.zeros(count),
-        "pair_active": np.zeros(count, dtype=i64),
-        "pair_friction": np.zeros(count),
-        "pair_bond": np.zeros(count),
         "pair_weight": np.zeros(count),
         "pair_bonded": np.zeros(count, dtype=np.bool_),
         "blend_force_owner": np.zeros((count, 3)),
@@ -148,9 +140,8 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         track_point_u=np.zeros(SLOTS * n_pts),
         track_point_w=np.zeros(SLOTS * n_pts),
         track_depth_shift=np.zeros(SLOTS * n_pts),
-        track_partial=np.zeros(SLOTS * n_pts, dtype=np.bool_),
-        track_released=np.zeros(SLOTS * n_pts, dtype=np.bool_),
-        track_failed=np.zeros(SLOTS * n_pts, dtype=np.int64),
+        pending=np.zeros(SLOTS * n_pts, dtype=np.int64),
+        pending_pair=np.zeros(SLOTS * n_pts, dtype=np.int64),
         release_overlap=np.zeros(SLOTS * n_pts),
         release_area=np.zeros(SLOTS * n_pts),
         velocity_mid=np.zeros((nb, 3)),
@@ -162,8 +153,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         block_iterate=np.zeros((2, nb, 6)),
         block_damped=np.zeros(nb, dtype=np.bool_),
         driven_velocity_last=np.zeros((nb, 3)),
-        threads=np.ones(1, dtype=np.int64),
-        poly=np.zeros((numba.config.NUMBA_NUM_THREADS, 2, 32, 2)),
+        poly=np.zeros((2, 32, 2)),
         prev_pair_count=np.zeros(1, dtype=np.int64),
         energy_scale=one.copy(),
         lost_block=np.full(1, -1, dtype=np.int64),

@@ -321,6 +321,6 @@ def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float
     if state == COVER_NONE:
         return 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
     return partly_covered(
-        m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly[0],
+        m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
         m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False, np.inf,
     )

@@ -5,24 +5,14 @@ is stored with its point of application, per sub-contact in ``sc.contact_force``
 ``sc.contact_point`` and per edge pair in ``sc.pair_force`` / ``sc.pair_point``, and then added to
 the blocks by :func:`accumulate` in the fixed pair order (so results do not depend on how the
 contacts were computed).
-
-Threads: the face pairs' passes (cover, clipping, joint law) write only their own pair's entries
-(per sub-contact forces, flags and per-pair energies), and everything shared is summed afterwards
-in pair order, so :func:`_face_pairs_parallel` gives the serial answer bit for bit on any number
-of threads. The parallel variant is compiled only when asked for (:data:`PARALLEL`, runs of
-``simulation.PARALLEL_BLOCKS`` blocks or more with several Numba threads): Numba compiles a
-parallel function's callees again with its own flags (minutes, once, then cached).
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
-import numba
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
+from numba import njit
 
 from .contact import (
     coulomb_limit,
@@ -41,7 +31,6 @@ from .layout import (
     DASHPOTS_IMPLICIT,
     E_BOND,
     E_FRICTION,
-    FAILED_NONE,
     FAILED_SHEAR,
     FAILED_TENSION,
     PAIR_EDGE,
@@ -138,70 +127,66 @@ def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
             _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, b, a, f[0], f[1], f[2], c[0], c[1], c[2])
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def _cover_pair(m: ModelArrays, s: State, sc: Scratch, i: int) -> None:
-    """Effective area and force point (``sc.track_area``, ``sc.track_point_u``,
-    ``sc.track_point_w``, ``sc.track_depth_shift``) of every sub-contact of FACE pair i whose cell
-    its target face wholly covers (zero area for faces at right angles); the others are flagged in
-    ``sc.track_partial`` and counted in ``sc.pair_partial[i]`` for :func:`_partial_pair`."""
-    sc.pair_partial[i] = 0
-    if s.pair_kind[i] == PAIR_EDGE:
-        return
-    split = s.pair_track_split[i]
-    for side in range(2):
-        k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
-        if k0 == k1:
+@njit(cache=True, _nrt=False)
+def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
+    """Effective area and force point (``sc.track_area``, ``sc.track_point_u``, ``sc.track_point_w``, ``sc.track_depth_shift``) of every sub-contact whose cell its target
+    face wholly covers (zero area for faces at right angles); the others are listed in
+    ``sc.pending`` for :func:`_partial_pass`. Returns how many are listed."""
+    npend = 0
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
             continue
-        fo, ft = _faces(s, i, side)
-        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        sc.pair_partial[i] += _cover_range(m, s, sc, k0, k1, ft, fm)
+        split = s.pair_track_split[i]
+        for side in range(2):
+            k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
+            if k0 == k1:
+                continue
+            fo, ft = _faces(s, i, side)
+            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+            npend = _cover_range(m, s, sc, i, k0, k1, ft, fm, npend)
+    return npend
 
 
 @njit(cache=True, _nrt=False, inline="always")
 def _faces(s: State, i: int, side: int) -> tuple[int, int]:
     """(face whose points press, face they press on) of FACE pair i: the owner's points on the
-    target (side 0) or the target's points on the owner face (side 1, kernels.blend)."""
+    target (side 0) or the target's points on the owner (side 1, kernels.blend)."""
     if side == 0:
         return s.pair_owner_face[i], s.pair_target_face[i]
     return s.pair_target_face[i], s.pair_owner_face[i]
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _cover_range(m: ModelArrays, s: State, sc: Scratch, k0: int, k1: int, ft: int, fm: FaceMap) -> int:
-    """The wholly covered (or uncovered) sub-contacts track[k0:k1] pressed on face ``ft``; returns
-    how many are partly covered (flagged for :func:`_partial_pair`)."""
+def _cover_range(m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, ft: int, fm: FaceMap, npend: int) -> int:
+    """The wholly covered (or uncovered) sub-contacts track[k0:k1] pressed on face ``ft``."""
     flat = abs(fm.det) < 1e-9
-    partial = 0
     for k in range(k0, k1):
         p = s.track[k] // SLOTS
         state = COVER_NONE if flat else covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, 0.0)
-        sc.track_partial[k] = state == COVER_PART
         if state != COVER_PART:
             sc.track_area[k] = m.point_area[p] if state == COVER_FULL else 0.0
             sc.track_point_u[k] = m.point_node[p, 0]
             sc.track_point_w[k] = m.point_node[p, 1]
             sc.track_depth_shift[k] = 0.0
         else:
-            partial += 1
-    return partial
+            sc.pending[npend] = k
+            sc.pending_pair[npend] = i
+            npend += 1
+    return npend
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def _partial_pair(m: ModelArrays, s: State, sc: Scratch, i: int, buf: np.ndarray) -> None:
-    """Clip the cells of pair i's sub-contacts flagged by :func:`_cover_pair`
-    (:func:`faces.partly_covered`); ``buf`` (2, 32, 2) is the calling thread's polygon buffer."""
-    if sc.pair_partial[i] == 0:
-        return
-    split = s.pair_track_split[i]
-    for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-        if not sc.track_partial[k]:
-            continue
-        fo, ft = _faces(s, i, 0 if k < split else 1)
+@njit(cache=True, _nrt=False)
+def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
+    """Clip the cells of the sub-contacts listed by :func:`_cover_pass` (:func:`faces.partly_covered`)."""
+    for q in range(npend):
+        k = sc.pending[q]
+        i = sc.pending_pair[q]
+        fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
         fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
         code = s.track[k]
         p = code // SLOTS
         area, yu, yw, shift = partly_covered(
-            m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
+            m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
             m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0,
             not s.slot_bonded[p, code - SLOTS * p], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
         )
@@ -211,61 +196,67 @@ def _partial_pair(m: ModelArrays, s: State, sc: Scratch, i: int, buf: np.ndarray
         sc.track_depth_shift[k] = shift
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> None:
-    """The joint law of FACE pair i's sub-contacts, their covers known: stores their forces and
-    points (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``), the pair's elastic
-    energy, active count and friction and bond energy dissipated (``sc.pair_elastic``,
-    ``sc.pair_active``, ``sc.pair_friction``, ``sc.pair_bond``), and flags the sub-contacts that
-    opened during the last step (``sc.track_released``, counted in ``sc.pair_released``) for
-    :func:`_release_pass` and those whose bond failed (``sc.track_failed``, ``sc.pair_failed``).
+@njit(cache=True, _nrt=False)
+def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
+    """The joint law of every sub-contact of the face pairs, their covers known: stores its force
+    and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
+    that opened during the last step in ``sc.pending`` for :func:`_release_pass`.
 
-    Writes only pair i's own entries (a point's slot belongs to one pair), so pairs may run in
-    parallel. (The one shared write, a detection request in ``s.moved``, stores the same value
-    from any pair.) Performance note: the law loop calls only small inlined functions and makes
-    no array views; a call to a compiled function with loops of its own (a clipping, a
-    quadrature) inside it made it ten times slower: such rare work is done in the other passes.
+    Returns (elastic energy, active count, friction and bond energy dissipated, opened count).
+    Performance note: this loop calls only small inlined functions and makes no array views. A
+    call to a compiled function, or an inlined one with loops of its own (a clipping, a
+    quadrature), anywhere in it stops Numba from pruning the reference counting of every array it
+    touches, which made it ten times slower: such rare work is done in the other passes.
     """
-    sc.pair_elastic[i] = 0.0
-    sc.pair_active[i] = 0
-    sc.pair_friction[i] = 0.0
-    sc.pair_bond[i] = 0.0
-    sc.pair_released[i] = 0
-    sc.pair_failed[i] = 0
-    if s.pair_kind[i] == PAIR_EDGE:
-        return
+    elastic = 0.0
+    active = 0
+    e_fric = 0.0
+    e_bond = 0.0
+    nrel = 0
     implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
-    fa = s.pair_owner_face[i]
-    fb = s.pair_target_face[i]
-    a = m.face_block[fa]
-    b = m.face_block[fb]
-    split = s.pair_track_split[i]
-    stop = s.pair_track_stop[i]
-    lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
-    # The owner's points on the target face, then (while the pair may blend) the target's on
-    # the owner face.
-    u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, implicit)
-    if split < stop:
-        u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, implicit)
-        if dlam != 0.0:
-            # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
-            g = (u_target - u_owner) * dlam
-            for c in range(3):
-                sc.blend_force_owner[i, c] *= g
-                sc.blend_force_target[i, c] *= g
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            continue
+        fa = s.pair_owner_face[i]
+        fb = s.pair_target_face[i]
+        a = m.face_block[fa]
+        b = m.face_block[fb]
+        split = s.pair_track_split[i]
+        stop = s.pair_track_stop[i]
+        lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
+        # The owner's points on the target face, then (while the pair may blend) the target's on
+        # the owner face.
+        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel, implicit)
+        elastic += el
+        active += ac
+        e_fric += ef
+        e_bond += eb
+        if split < stop:
+            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel, implicit)
+            elastic += el
+            active += ac
+            e_fric += ef
+            e_bond += eb
+            if dlam != 0.0:
+                # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
+                g = (u_target - u_owner) * dlam
+                for c in range(3):
+                    sc.blend_force_owner[i, c] *= g
+                    sc.blend_force_target[i, c] *= g
+    return elastic, active, e_fric, e_bond, nrel
 
 
 @njit(cache=True, _nrt=False)
 def _law_range(
     m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, implicit: bool,
-) -> float:
+    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool,
+) -> tuple[float, int, float, float, int, float]:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
     False: the whole pair, wgt 1). With ``implicit`` dashpots (:mod:`rockdem.kernels.implicit`) only
     half the dashpot force at the last half step's velocity is applied here and each active
-    dashpot is stored (``sc.dashpot_*``) for the velocity solve. Adds its energies and counts to
-    pair i's (:func:`_law_pair`); returns the normal spring energy at full share."""
+    dashpot is stored (``sc.dashpot_*``) for the velocity solve. Returns (elastic energy, active count, friction and bond energy
+    dissipated, the new opened count, the normal spring energy at full share)."""
     elastic = 0.0
     active = 0
     e_fric = 0.0
@@ -283,8 +274,6 @@ def _law_range(
         p = code // SLOTS
         j = code - SLOTS * p
         sc.dashpot_cn[k] = 0.0
-        sc.track_released[k] = False
-        sc.track_failed[k] = FAILED_NONE
         sc.dashpot_force[k, 0] = 0.0
         sc.dashpot_force[k, 1] = 0.0
         sc.dashpot_force[k, 2] = 0.0
@@ -320,7 +309,7 @@ def _law_range(
             # Tension cut-off: the bond fails and the point opens.
             e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
             s.slot_bonded[p, j] = False
-            _fail(sc, i, k, FAILED_TENSION)
+            s.point_failed[p] = FAILED_TENSION
             opened = True
             bonded = False
             prev_area = 0.0  # its energy is counted
@@ -330,14 +319,15 @@ def _law_range(
             if bonded:
                 e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
                 s.slot_bonded[p, j] = False
-                _fail(sc, i, k, FAILED_SHEAR if un > 0.0 else FAILED_TENSION)
+                s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
             elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
                 # Opened during the last step: its release is computed apart (release pass), its
                 # shear extension kept until then.
-                sc.track_released[k] = True
-                sc.release_overlap[k] = un_prev
-                sc.release_area[k] = prev_area
-                sc.pair_released[i] += 1
+                sc.pending[nrel] = k
+                sc.pending_pair[nrel] = i
+                sc.release_overlap[nrel] = un_prev
+                sc.release_area[nrel] = prev_area
+                nrel += 1
                 s.slot_normal_force[p, j] = 0.0
                 continue
             else:
@@ -369,7 +359,7 @@ def _law_range(
             if bonded:
                 # Shear failure: drop to the residual strength; the released energy is the bond's.
                 s.slot_bonded[p, j] = False
-                _fail(sc, i, k, FAILED_SHEAR)
+                s.point_failed[p] = FAILED_SHEAR
                 fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
                 e_bond += drop_dissipation(fmax, fres, ksa)
                 fmax = fres
@@ -423,19 +413,7 @@ def _law_range(
             f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
             x0, x1, x2,
         )
-    sc.pair_elastic[i] += elastic
-    sc.pair_active[i] += active
-    sc.pair_friction[i] += e_fric
-    sc.pair_bond[i] += e_bond
-    return u_side
-
-
-@njit(cache=True, _nrt=False, inline="always")
-def _fail(sc: Scratch, i: int, k: int, mode: int) -> None:
-    """Sub-contact k of pair i lost its bond by ``mode`` (FAILED_*): noted per sub-contact and
-    copied to ``s.point_failed`` in pair order after the pass (:func:`_note_failures`)."""
-    sc.track_failed[k] = mode
-    sc.pair_failed[i] += 1
+    return elastic, active, e_fric, e_bond, nrel, u_side
 
 
 @njit(cache=True, _nrt=False)
@@ -498,16 +476,16 @@ def _released_dashpot(
 
 
 @njit(cache=True, _nrt=False)
-def _release_pass(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> float:
-    """Sub-contacts of pair i that opened during the last step (flagged by :func:`_law_pair`):
-    complete the impulses of the normal ramp and of the capped shear force up to the opening time
+def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -> float:
+    """Sub-contacts that opened during the last step (listed by :func:`_law_pass`): complete the
+    impulses of the normal ramp and of the capped shear force up to the opening time
     (:func:`contact.ramp_overlap`, :func:`contact.release_shear`); returns the friction energy."""
     e_fric = 0.0
-    for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-        if not sc.track_released[k]:
-            continue
-        un_prev = sc.release_overlap[k]
-        prev_area = sc.release_area[k]
+    for q in range(nrel):
+        k = sc.pending[q]
+        i = sc.pending_pair[q]
+        un_prev = sc.release_overlap[q]
+        prev_area = sc.release_area[q]
         fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
         fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
         o = m.face_block[fo]
@@ -679,99 +657,11 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     return spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa), 1, e_fric
 
 
-PARALLEL_PAIRS = 64
-"""Contact pairs from which the face pairs' force passes run on the ``sc.threads`` Numba threads
-(set by the driver from ``numba.get_num_threads()``: NUMBA_NUM_THREADS or
-``numba.set_num_threads``); smaller models stay serial (a parallel loop's launch costs more than a
-few pairs' work)."""
-
-PAIR_CHUNK = 32
-"""Pairs per task of the parallel force passes."""
-
-
 @njit(cache=True, _nrt=False)
-def _cover_pass(m: ModelArrays, s: State, sc: Scratch, i0: int, i1: int) -> None:
-    """:func:`_cover_pair` of pairs i0..i1-1."""
-    for i in range(i0, i1):
-        _cover_pair(m, s, sc, i)
-
-
-@njit(cache=True, _nrt=False)
-def _partial_pass(m: ModelArrays, s: State, sc: Scratch, i0: int, i1: int, buf: np.ndarray) -> None:
-    """:func:`_partial_pair` of pairs i0..i1-1 with the polygon buffer ``buf`` (2, 32, 2)."""
-    for i in range(i0, i1):
-        _partial_pair(m, s, sc, i, buf)
-
-
-@njit(cache=True, _nrt=False)
-def _law_pass(m: ModelArrays, s: State, sc: Scratch, i0: int, i1: int, dt: float) -> None:
-    """:func:`_law_pair` of pairs i0..i1-1."""
-    for i in range(i0, i1):
-        _law_pair(m, s, sc, i, dt)
-
-
-@njit(cache=True, _nrt=False)
-def _face_pairs(m: ModelArrays, s: State, sc: Scratch, i0: int, i1: int, dt: float, buf: np.ndarray) -> None:
-    """Cover, clip and joint law of FACE pairs i0..i1-1, one pass each (the passes are separate
-    functions: each compiles to a tight loop, see :func:`_law_pair`)."""
-    _cover_pass(m, s, sc, i0, i1)
-    _partial_pass(m, s, sc, i0, i1, buf)
-    _law_pass(m, s, sc, i0, i1, dt)
-
-
-class Parallel(NamedTuple):
-    """Marker argument of :func:`compute_forces` (and ``step.advance``): compile the variant whose
-    face-pair passes run on the Numba threads once a model has PARALLEL_PAIRS pairs. Its own type
-    selects the variant at compile time, so the default serial variant never compiles (nor
-    waits for) the parallel code: Numba compiles a parallel function's callees again with its
-    flags, minutes of compilation that small models would not use."""
-
-
-PARALLEL = Parallel()
-
-
-def _face_pair_passes(m: ModelArrays, s: State, sc: Scratch, dt: float, how: Parallel | None) -> None:
-    """The face pairs' passes, on the threads when ``how`` is :data:`PARALLEL` (compiled only)."""
-    raise NotImplementedError("compiled only (numba overload)")
-
-
-@overload(_face_pair_passes, jit_options={"_nrt": False}, inline="always")
-def _face_pair_passes_impl(m, s, sc, dt, how):  # type: ignore[no-untyped-def]
-    if isinstance(how, types.BaseNamedTuple) and how.instance_class is Parallel:
-        def on_threads(m, s, sc, dt, how):  # type: ignore[no-untyped-def]
-            if s.pair_count[0] >= PARALLEL_PAIRS and sc.threads[0] > 1:
-                _face_pairs_parallel(m, s, sc, dt)
-            else:
-                _face_pairs(m, s, sc, 0, s.pair_count[0], dt, sc.poly[0])
-        return on_threads
-
-    def serial(m, s, sc, dt, how):  # type: ignore[no-untyped-def]
-        _face_pairs(m, s, sc, 0, s.pair_count[0], dt, sc.poly[0])
-    return serial
-
-
-@njit(cache=True, _nrt=False, parallel=True)
-def _face_pairs_parallel(m: ModelArrays, s: State, sc: Scratch, dt: float) -> None:
-    """:func:`_face_pairs` of all pairs in chunks of PAIR_CHUNK shared among the threads. Each pair
-    writes only its own entries, so the result is the same bit for bit whatever the thread count."""
-    n = s.pair_count[0]
-    for c in numba.prange((n + PAIR_CHUNK - 1) // PAIR_CHUNK):
-        _face_pairs(m, s, sc, c * PAIR_CHUNK, min(n, (c + 1) * PAIR_CHUNK), dt, sc.poly[numba.get_thread_id()])
-
-
-@njit(cache=True, _nrt=False)
-def _note_failures(s: State, sc: Scratch, i: int) -> None:
-    """Copy the bond failures of pair i's sub-contacts to their points (``s.point_failed``)."""
-    for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-        if sc.track_failed[k] != FAILED_NONE:
-            s.point_failed[s.track[k] // SLOTS] = sc.track_failed[k]
-
-
-@njit(cache=True, _nrt=False)
-def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, how: Parallel | None = None) -> None:
+def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
     """Forces and torques on every block at the current poses (joint law of paper §3); ``t`` [s] is
     the time at which body loads (inertial earthquake loading) are sampled, ``dt`` [s] the step
-    just taken; ``how``: :data:`PARALLEL` for the variant on threads (None: serial)."""
+    just taken."""
     nb = m.block_mass.shape[0]
     sc.force[:] = 0.0
     sc.torque[:] = 0.0
@@ -784,20 +674,13 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, h
         if m.block_free[b]:
             for i in range(3):
                 sc.force[b, i] = m.block_mass[b] * (m.gravity[i] + sc.body_acc[i])
-    _face_pair_passes(m, s, sc, dt, how)
-    elastic = 0.0
-    active = 0
-    e_fric = 0.0
-    e_bond = 0.0
-    for i in range(s.pair_count[0]):  # in pair order: the sums do not depend on the threads
-        elastic += sc.pair_elastic[i]
-        active += sc.pair_active[i]
-        e_fric += sc.pair_friction[i]
-        e_bond += sc.pair_bond[i]
-        if sc.pair_released[i] > 0:
-            e_fric += _release_pass(m, s, sc, i, dt)
-        if sc.pair_failed[i] > 0:
-            _note_failures(s, sc, i)
+    npend = _cover_pass(m, s, sc)
+    if npend > 0:
+        _partial_pass(m, s, sc, npend)
+    elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt)
+    if nrel > 0:
+        e_fric += _release_pass(m, s, sc, nrel, dt)
+    for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             el, ac, ef = _edge_pair(m, s, sc, i, dt)
             elastic += el

@@ -218,10 +218,9 @@ class Scratch(NamedTuple):
     track_point_u: np.ndarray  # (SLOTS np,) [m] its force point, owner face coordinate u
     track_point_w: np.ndarray  # (SLOTS np,) [m] ... and w
     track_depth_shift: np.ndarray  # (SLOTS np,) [m] overlap at the force point minus its overlap (<= 0, faces.partly_covered)
-    track_partial: np.ndarray  # (SLOTS np,) bool its cell is partly covered: clipped by the partial pass
-    track_released: np.ndarray  # (SLOTS np,) bool it opened during the last step: completed by the release pass
-    track_failed: np.ndarray  # (SLOTS np,) int64 FAILED_* its bond failed at this step, FAILED_NONE otherwise
-    release_overlap: np.ndarray  # (SLOTS np,) [m] overlap at the previous step of an opened one
+    pending: np.ndarray  # (SLOTS np,) int64 tracked sub-contacts left for a later pass
+    pending_pair: np.ndarray  # (SLOTS np,) int64 their pairs
+    release_overlap: np.ndarray  # (SLOTS np,) [m] overlap at the previous step of each opened one
     release_area: np.ndarray  # (SLOTS np,) [m^2] its area at the previous step
     pair_force: np.ndarray  # (P, 3) [N] EDGE pairs: force on block a
     pair_point: np.ndarray  # (P, 3) [m] its point of application
@@ -229,13 +228,6 @@ class Scratch(NamedTuple):
     pair_dashpot_cn: np.ndarray  # (P,) [N s/m] EDGE pairs: normal dashpot, 0 inactive
     pair_dashpot_cs: np.ndarray  # (P,) [N s/m] EDGE pairs: shear dashpot
     pair_dashpot_velocity: np.ndarray  # (P, 3) [m/s] EDGE pairs: relative velocity of a to b at the last half step
-    pair_partial: np.ndarray  # (P,) int64 FACE: its partly covered sub-contacts at this step
-    pair_released: np.ndarray  # (P,) int64 FACE: its sub-contacts opened during the last step
-    pair_failed: np.ndarray  # (P,) int64 FACE: its sub-contacts whose bond failed at this step
-    pair_elastic: np.ndarray  # (P,) [J] FACE: energy stored in its springs
-    pair_active: np.ndarray  # (P,) int64 FACE: its sub-contacts in compression (or bonded)
-    pair_friction: np.ndarray  # (P,) [J] FACE: friction energy dissipated at this step
-    pair_bond: np.ndarray  # (P,) [J] FACE: bond energy released at this step
     pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
@@ -253,8 +245,7 @@ class Scratch(NamedTuple):
     block_damped: np.ndarray  # (nb,) bool the block has an active dashpot this step
     driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots)
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
-    threads: np.ndarray  # (1,) int64 Numba threads the force passes may use (set by the driver before each chunk)
-    poly: np.ndarray  # (T, 2, 32, 2) per Numba thread, two polygon buffers for clipping (source and destination alternate)
+    poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
     cand_code: np.ndarray  # (C,) int64 detection: candidate point p (slot assigned later)
     cand_partner: np.ndarray  # (C,) int64
     cand_face: np.ndarray  # (C,) int64 target face

@@ -23,7 +23,7 @@ from numba import njit
 
 from .bound import contact_bound
 from .detect import detect, update_rotations
-from .forces import Parallel, compute_forces
+from .forces import compute_forces
 from .implicit import couple, factor_block, finalize, mark_damped, solve_block, sweep
 from .layout import (
     DASHPOTS_EXPLICIT,
@@ -412,8 +412,7 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
 
 @njit(cache=True, _nrt=False)
 def advance(
-    m: ModelArrays, s: State, sc: Scratch, t_stop: float, record_interval: float, rec: Records, frame: int,
-    how: Parallel | None = None,
+    m: ModelArrays, s: State, sc: Scratch, t_stop: float, record_interval: float, rec: Records, frame: int
 ) -> tuple[int, int]:
     """Step until time ``t_stop`` [s], recording a frame every ``record_interval``.
 
@@ -423,9 +422,7 @@ def advance(
     tracked contacts is recomputed and dt is lowered (never raised) to (2 / omega_max)
     min(safety f_SP, resolution) (:mod:`rockdem.timestep`), so that contacts stiffer than those at
     the start (a toppling block landing on a side face) stay stable and resolved. Velocities use
-    the mean of the two step lengths. ``how``: :data:`~rockdem.kernels.forces.PARALLEL` compiles the
-    variant whose contact passes run on the Numba threads (``sc.threads``) for models with many
-    contact pairs; None (default) the serial one.
+    the mean of the two step lengths.
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
@@ -453,7 +450,7 @@ def advance(
         h = 0.5 * (s.dt_prev[0] + dt)
         # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + dt/2]
         # (t itself unless the step was just lowered).
-        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0], how)
+        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT:
             dashpot_work(m, s, sc, h)
