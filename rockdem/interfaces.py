@@ -121,6 +121,18 @@ def _face_frames(poly: Polyhedron) -> list[tuple[NDArray[np.float64], NDArray[np
     return [(poly.vertices[f], poly.normals[i], float(poly.offsets[i])) for i, f in enumerate(poly.faces)]
 
 
+def _plane_axes(n: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit axes (u, w) of a plane of unit normal n (3,), with u x w = n."""
+    u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+    u /= np.linalg.norm(u)
+    return u, np.cross(n, u)
+
+
+def _thinnest(bodies: Sequence[Body]) -> NDArray[np.float64]:
+    """(nb,) each block's smallest dimension along the axes [m] (reference pose)."""
+    return np.array([float(np.ptp(b.poly.vertices, axis=0).min()) for b in bodies])
+
+
 def _ccw(v: NDArray[np.float64], u: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
     """(k, 2) counter-clockwise polygon of the face vertices v (k, 3) in the plane coordinates (u, w)."""
     q = np.column_stack((v @ u, v @ w))
@@ -129,10 +141,7 @@ def _ccw(v: NDArray[np.float64], u: NDArray[np.float64], w: NDArray[np.float64])
 
 def _overlap(va: NDArray[np.float64], vb: NDArray[np.float64], n: NDArray[np.float64]) -> float:
     """Area [m^2] of the overlap of two facing convex polygons (k, 3), projected on the plane of normal n."""
-    u = va[1] - va[0]
-    u = u - n * (n @ u)
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
+    u, w = _plane_axes(n)
     clipped = _clip(_ccw(va, u, w), _ccw(vb, u, w))  # b's face runs counter-clockwise about -n: reoriented
     return abs(_polygon_area(clipped)) if len(clipped) >= 3 else 0.0
 
@@ -152,7 +161,7 @@ def face_contacts(bodies: Sequence[Body], *, gap_fraction: float = GAP_FRACTION)
         raise ValueError(f"gap_fraction must be >= 0, got {gap_fraction!r}")
     lo = np.array([b.poly.vertices.min(axis=0) for b in bodies])
     hi = np.array([b.poly.vertices.max(axis=0) for b in bodies])
-    thin = (hi - lo).min(axis=1)
+    thin = _thinnest(bodies)
     free = np.array([b.free for b in bodies], dtype=bool)
     cos_tol = math.cos(math.radians(FACING_TOL_DEG))
     frames = [_face_frames(b.poly) for b in bodies]
@@ -262,9 +271,7 @@ def _row_strike(bodies: Sequence[Body], imp: _Impact) -> tuple[float, float] | N
     """
     own = bodies[imp.block]
     n = imp.normal
-    u = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])  # plane coordinates (u, w) normal to n
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
+    u, w = _plane_axes(n)
     pts, areas, owner = [], [], []
     for c in imp.contacts:
         faces = [(bodies[c.a], c.face_a, bodies[c.b], c.face_b), (bodies[c.b], c.face_b, bodies[c.a], c.face_a)]
@@ -335,15 +342,7 @@ def model_bodies(model) -> list[Body]:  # noqa: ANN001 - a rockdem.model.Model (
 
 
 def _largest_face(poly: Polyhedron) -> float:
-    return max(abs(_polygon_area(np.column_stack(_plane_coords(poly.vertices[f], poly.normals[k])))) for k, f in enumerate(poly.faces))
-
-
-def _plane_coords(v: NDArray[np.float64], n: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    u = v[1] - v[0]
-    u = u - n * (n @ u)
-    u /= np.linalg.norm(u)
-    w = np.cross(n, u)
-    return v @ u, v @ w
+    return max(abs(_polygon_area(_ccw(poly.vertices[f], *_plane_axes(poly.normals[k])))) for k, f in enumerate(poly.faces))
 
 
 def critical_pair_betas(
@@ -370,7 +369,7 @@ def critical_pair_betas(
         raise ValueError(f"damping.damping_ratio must be a positive number (1 = critical), got {damping_ratio!r}")
     if contacts is None:
         contacts = face_contacts(bodies, gap_fraction=gap_fraction)
-    thin = np.array([float(np.ptp(b.poly.vertices, axis=0).min()) for b in bodies])
+    thin = _thinnest(bodies)
     by_block: dict[int, list[FaceContact]] = {}
     for c in contacts:
         by_block.setdefault(c.a, []).append(c)
