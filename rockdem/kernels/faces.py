@@ -134,18 +134,76 @@ COVER_NONE = 0
 COVER_PART = -1
 
 
+ALL_LINES = -1
+"""Line mask of :func:`covered` that tests every edge line of the target face."""
+
+MASK_LINES = 62
+"""Faces with more edge lines than this are tested line by line (:func:`crossing_lines` masks
+only up to this many)."""
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def crossing_lines(
+    corner_start: np.ndarray, corner: np.ndarray, vertex_local: np.ndarray, face_origin: np.ndarray,
+    face_u: np.ndarray, face_w: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
+    fo: int, ft: int, fm: FaceMap,
+) -> int:
+    """Which edge lines of target face ``ft`` cross owner face ``fo`` (mapped by ``fm``): a bit mask
+    (bit i: line ``line_start[ft] + i``) for :func:`covered`, or -2 when one line leaves the whole
+    owner face outside (no cell covered).
+
+    Every cell lies in its face, and a line's signed distance is affine, so a line that leaves all
+    the face's corners inside (within INSIDE_TOL) leaves every cell inside: only the crossing lines
+    need testing per cell (none for a flush joint, one where a head joint crosses a bed joint), with
+    the same answer as testing them all. ALL_LINES for faces with more than MASK_LINES lines.
+    """
+    l0 = line_start[ft]
+    nl = line_start[ft + 1] - l0
+    c0 = corner_start[fo]
+    nc = corner_start[fo + 1] - c0
+    if nl > MASK_LINES or nc > buf.shape[1]:
+        return ALL_LINES
+    # The owner face's corners in target coordinates, into buf[0].
+    ox, oy, oz = face_origin[fo, 0], face_origin[fo, 1], face_origin[fo, 2]
+    for c in range(nc):
+        v = corner[c0 + c]
+        x0, x1, x2 = vertex_local[v, 0] - ox, vertex_local[v, 1] - oy, vertex_local[v, 2] - oz
+        cu = x0 * face_u[fo, 0] + x1 * face_u[fo, 1] + x2 * face_u[fo, 2]
+        cw = x0 * face_w[fo, 0] + x1 * face_w[fo, 1] + x2 * face_w[fo, 2]
+        buf[0, c, 0] = fm.m00 * cu + fm.m01 * cw + fm.t0
+        buf[0, c, 1] = fm.m10 * cu + fm.m11 * cw + fm.t1
+    mask = 0
+    for i in range(nl):
+        lu = line[l0 + i, 0]
+        lw = line[l0 + i, 1]
+        lo = line[l0 + i, 2]
+        hi = -np.inf
+        low = np.inf
+        for c in range(nc):
+            d = lu * buf[0, c, 0] + lw * buf[0, c, 1] - lo
+            hi = max(hi, d)
+            low = min(low, d)
+        if low > INSIDE_TOL:
+            return -2
+        if hi > INSIDE_TOL:
+            mask |= 1 << i
+    return mask
+
+
 @njit(cache=True, _nrt=False, inline="always")
 def covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray,
-    p: int, ft: int, fm: FaceMap, grow: float,
+    p: int, ft: int, fm: FaceMap, grow: float, mask: int,
 ) -> int:
     """Whether the target polygon (grown by ``grow``) covers the cell of point p wholly
     (COVER_FULL), not at all because one of its edge lines leaves the cell outside (COVER_NONE), or
-    in part (COVER_PART, to be clipped by :func:`partly_covered`)."""
+    in part (COVER_PART, to be clipped by :func:`partly_covered`). Only the lines of ``mask``
+    (:func:`crossing_lines`, or ALL_LINES) are tested."""
     full = True
     none = False
     c0 = cell_start[p]
     nv = cell_start[p + 1] - c0
+    l0 = line_start[ft]
     if nv == 4:  # the usual rectangular cell: its corners mapped once
         a0 = fm.m00 * cell_vertex[c0, 0] + fm.m01 * cell_vertex[c0, 1] + fm.t0
         b0 = fm.m10 * cell_vertex[c0, 0] + fm.m11 * cell_vertex[c0, 1] + fm.t1
@@ -155,7 +213,9 @@ def covered(
         b2 = fm.m10 * cell_vertex[c0 + 2, 0] + fm.m11 * cell_vertex[c0 + 2, 1] + fm.t1
         a3 = fm.m00 * cell_vertex[c0 + 3, 0] + fm.m01 * cell_vertex[c0 + 3, 1] + fm.t0
         b3 = fm.m10 * cell_vertex[c0 + 3, 0] + fm.m11 * cell_vertex[c0 + 3, 1] + fm.t1
-        for li in range(line_start[ft], line_start[ft + 1]):
+        for li in range(l0, line_start[ft + 1]):
+            if mask != ALL_LINES and not (mask >> (li - l0)) & 1:
+                continue
             lu = line[li, 0]
             lw = line[li, 1]
             lo = line[li, 2] + grow
@@ -167,7 +227,9 @@ def covered(
                 full = False
                 none = none or min(min(d0, d1), min(d2, d3)) >= -INSIDE_TOL
     else:
-        for li in range(line_start[ft], line_start[ft + 1]):
+        for li in range(l0, line_start[ft + 1]):
+            if mask != ALL_LINES and not (mask >> (li - l0)) & 1:
+                continue
             lu = line[li, 0]
             lw = line[li, 1]
             lo = line[li, 2] + grow
@@ -202,10 +264,10 @@ def _cell_to_target(cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.nda
 def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
-    lumped: bool, target_cell_area: float,
+    lumped: bool, target_cell_area: float, mask: int,
 ) -> tuple[float, float, float, float]:
     """Effective area, force point (u, w) and depth shift of a cell the target polygon does not
-    wholly cover.
+    wholly cover (clipped by the target's edge lines in ``mask``, :func:`crossing_lines`).
 
     The force point: from the point p (or the nearest covered point q when p is off the target)
     towards the deepest covered vertex d, by w phi'(g): w the cover weight (how much of the cell is
@@ -234,7 +296,10 @@ def partly_covered(
     node_in = True
     n = nv
     cur = 0  # the buffer holding the current polygon
-    for li in range(line_start[ft], line_start[ft + 1]):
+    l0 = line_start[ft]
+    for li in range(l0, line_start[ft + 1]):
+        if mask != ALL_LINES and not (mask >> (li - l0)) & 1:
+            continue
         lu = line[li, 0]
         lw = line[li, 1]
         lo = line[li, 2] + grow
@@ -280,9 +345,23 @@ def partly_covered(
             tw = nw_ + wgt * (dw_ - nw_) - fm.t1
             yu = inv * (fm.m11 * tu - fm.m01 * tw)  # back to owner coordinates
             yw = inv * (-fm.m10 * tu + fm.m00 * tw)
-        if lumped:
+        if lumped and _straddles(cell_start, cell_vertex, p, fm):
+            # (A cell wholly on one side of the target plane has the lumped area of its covered part.)
             area = max(area, min(_lumped_area(cell_start, cell_vertex, buf, cur, n, point_area, area, p, fm, gu, gw), target_cell_area))
     return area, yu, yw, shift
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _straddles(cell_start: np.ndarray, cell_vertex: np.ndarray, p: int, fm: FaceMap) -> bool:
+    """Whether the cell of point p has vertices both above and below the target plane (only then
+    does its lumped area differ from its covered area, :func:`_lumped_area`)."""
+    above = False
+    below = False
+    for k in range(cell_start[p], cell_start[p + 1]):
+        h = fm.h0 + fm.hu * cell_vertex[k, 0] + fm.hw * cell_vertex[k, 1]
+        above = above or h > 0.0
+        below = below or h < 0.0
+    return above and below
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -305,6 +384,28 @@ def _lumped_area(
     return point_area * min(covered_below / below, 1.0)
 
 
+@njit(cache=True, _nrt=False)
+def cut_cell(
+    cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
+    nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, mask: int,
+    lumped: bool, target_cell_area: float,
+) -> tuple[float, float, float, float]:
+    """Effective area, force point (u, w) and depth shift of point p's cell (node (nu, nw), area
+    ``point_area``) against target face ``ft`` when target edge lines cross the owner face
+    (``mask``, :func:`crossing_lines`): :func:`covered` against those lines, then
+    :func:`partly_covered` (``lumped``, ``target_cell_area`` as there) where the cell is cut.
+    Compiled out of line, so that the joint law's loop stays small for flush joints."""
+    state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, 0.0, mask)
+    if state == COVER_FULL:
+        return point_area, nu, nw, 0.0
+    if state == COVER_NONE:
+        return 0.0, nu, nw, 0.0
+    return partly_covered(
+        cell_start, cell_vertex, line_start, line, buf, nu, nw, point_area, touch_tol, p, ft, fm, 0.0,
+        lumped, target_cell_area, mask,
+    )
+
+
 @njit(cache=True, _nrt=False, inline="always")
 def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float) -> tuple[float, float, float, float]:
     """Effective area [m^2] of point p against target face ``ft`` (its cell clipped by the target
@@ -315,12 +416,12 @@ def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float
     taking only the arrays they use: Numba compiles such small functions far better than one
     taking the whole model and scratch tuples, 50 ns instead of 1 us per sub-contact.)
     """
-    state = covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, grow)
+    state = covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, grow, ALL_LINES)
     if state == COVER_FULL:
         return m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
     if state == COVER_NONE:
         return 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
     return partly_covered(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False, np.inf,
+        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False, np.inf, ALL_LINES,
     )

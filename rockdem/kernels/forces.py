@@ -26,7 +26,7 @@ from .contact import (
     spring_energy,
 )
 from .blend import blend_weight, face_clearance, tracks_target
-from .faces import COVER_FULL, COVER_NONE, COVER_PART, FaceMap, covered, face_map_arrays, partly_covered
+from .faces import crossing_lines, cut_cell, face_map_arrays
 from .layout import (
     DASHPOTS_IMPLICIT,
     E_BOND,
@@ -96,9 +96,43 @@ def _apply(
         reaction[2] -= f2
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _apply_resultant(
+    position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
+    o: int, t: int, f0: float, f1: float, f2: float, m0: float, m1: float, m2: float,
+) -> None:
+    """Resultant f of a set of contact forces on block o, with moment m about o's centroid: f and m
+    on o, -f and -(m + (x_o - x_t) x f) on t; the reaction of driven blocks."""
+    if f0 == 0.0 and f1 == 0.0 and f2 == 0.0 and m0 == 0.0 and m1 == 0.0 and m2 == 0.0:
+        return
+    d0, d1, d2 = position[o, 0] - position[t, 0], position[o, 1] - position[t, 1], position[o, 2] - position[t, 2]
+    force[o, 0] += f0
+    force[o, 1] += f1
+    force[o, 2] += f2
+    force[t, 0] -= f0
+    force[t, 1] -= f1
+    force[t, 2] -= f2
+    torque[o, 0] += m0
+    torque[o, 1] += m1
+    torque[o, 2] += m2
+    torque[t, 0] -= m0 + d1 * f2 - d2 * f1
+    torque[t, 1] -= m1 + d2 * f0 - d0 * f2
+    torque[t, 2] -= m2 + d0 * f1 - d1 * f0
+    if free[o] and not free[t]:
+        reaction[0] += f0
+        reaction[1] += f1
+        reaction[2] += f2
+    elif free[t] and not free[o]:
+        reaction[0] -= f0
+        reaction[1] -= f1
+        reaction[2] -= f2
+
+
 @njit(cache=True, _nrt=False)
 def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
-    """Add every stored contact force to its two blocks (and to the reaction of driven blocks)."""
+    """Add the forces of the edge pairs and the blend forces of the face pairs to their two blocks
+    (and to the reaction of driven blocks), in pair order. (The face pairs' sub-contacts were added
+    by :func:`_law_range`, per pair side, and released ones by :func:`_release_pass`.)"""
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             f = sc.pair_force[i]
@@ -107,17 +141,6 @@ def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
             continue
         a = m.face_block[s.pair_owner_face[i]]
         b = m.face_block[s.pair_target_face[i]]
-        split = s.pair_track_split[i]
-        for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
-            f0 = sc.contact_force[k, 0]
-            f1 = sc.contact_force[k, 1]
-            f2 = sc.contact_force[k, 2]
-            if f0 != 0.0 or f1 != 0.0 or f2 != 0.0:
-                o, t = (a, b) if k < split else (b, a)
-                _apply(
-                    s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f0, f1, f2,
-                    sc.contact_point[k, 0], sc.contact_point[k, 1], sc.contact_point[k, 2],
-                )
         if sc.pair_weight[i] > 0.0 and sc.pair_weight[i] < 1.0:
             f = sc.blend_force_owner[i]
             c = sc.blend_point_owner[i]
@@ -125,26 +148,6 @@ def accumulate(m: ModelArrays, s: State, sc: Scratch) -> None:
             f = sc.blend_force_target[i]
             c = sc.blend_point_target[i]
             _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, b, a, f[0], f[1], f[2], c[0], c[1], c[2])
-
-
-@njit(cache=True, _nrt=False)
-def _cover_pass(m: ModelArrays, s: State, sc: Scratch) -> int:
-    """Effective area and force point (``sc.track_area``, ``sc.track_point_u``, ``sc.track_point_w``, ``sc.track_depth_shift``) of every sub-contact whose cell its target
-    face wholly covers (zero area for faces at right angles); the others are listed in
-    ``sc.pending`` for :func:`_partial_pass`. Returns how many are listed."""
-    npend = 0
-    for i in range(s.pair_count[0]):
-        if s.pair_kind[i] == PAIR_EDGE:
-            continue
-        split = s.pair_track_split[i]
-        for side in range(2):
-            k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
-            if k0 == k1:
-                continue
-            fo, ft = _faces(s, i, side)
-            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-            npend = _cover_range(m, s, sc, i, k0, k1, ft, fm, npend)
-    return npend
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -156,49 +159,9 @@ def _faces(s: State, i: int, side: int) -> tuple[int, int]:
     return s.pair_target_face[i], s.pair_owner_face[i]
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def _cover_range(m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, ft: int, fm: FaceMap, npend: int) -> int:
-    """The wholly covered (or uncovered) sub-contacts track[k0:k1] pressed on face ``ft``."""
-    flat = abs(fm.det) < 1e-9
-    for k in range(k0, k1):
-        p = s.track[k] // SLOTS
-        state = COVER_NONE if flat else covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, 0.0)
-        if state != COVER_PART:
-            sc.track_area[k] = m.point_area[p] if state == COVER_FULL else 0.0
-            sc.track_point_u[k] = m.point_node[p, 0]
-            sc.track_point_w[k] = m.point_node[p, 1]
-            sc.track_depth_shift[k] = 0.0
-        else:
-            sc.pending[npend] = k
-            sc.pending_pair[npend] = i
-            npend += 1
-    return npend
-
-
-@njit(cache=True, _nrt=False)
-def _partial_pass(m: ModelArrays, s: State, sc: Scratch, npend: int) -> None:
-    """Clip the cells of the sub-contacts listed by :func:`_cover_pass` (:func:`faces.partly_covered`)."""
-    for q in range(npend):
-        k = sc.pending[q]
-        i = sc.pending_pair[q]
-        fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
-        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        code = s.track[k]
-        p = code // SLOTS
-        area, yu, yw, shift = partly_covered(
-            m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-            m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0,
-            not s.slot_bonded[p, code - SLOTS * p], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
-        )
-        sc.track_area[k] = area
-        sc.track_point_u[k] = yu
-        sc.track_point_w[k] = yw
-        sc.track_depth_shift[k] = shift
-
-
 @njit(cache=True, _nrt=False)
 def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
-    """The joint law of every sub-contact of the face pairs, their covers known: stores its force
+    """The cover and joint law of every sub-contact of the face pairs: stores its force
     and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
     that opened during the last step in ``sc.pending`` for :func:`_release_pass`.
 
@@ -262,7 +225,15 @@ def _law_range(
     e_fric = 0.0
     e_bond = 0.0
     u_side = 0.0
+    sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = 0.0
     fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+    # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
+    # lines that cross the owner face are found once for the pair; with none every cell is wholly
+    # covered (a flush joint), with one leaving the face outside none is (faces at right angles too).
+    mask = -2 if abs(fm.det) < 1e-9 else crossing_lines(
+        m.face_corner_start, m.face_corner, m.vertex_local, m.face_origin, m.face_u, m.face_w,
+        m.face_line_start, m.face_line, sc.poly, fo, ft, fm,
+    )
     go = m.block_group[o]
     gt = m.block_group[t]
     kn = m.mat_kn[go, gt]
@@ -273,6 +244,19 @@ def _law_range(
         code = s.track[k]
         p = code // SLOTS
         j = code - SLOTS * p
+        if mask == 0:
+            full_area, yu, yw, shift = m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
+        elif mask == -2:
+            full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
+        else:
+            full_area, yu, yw, shift = cut_cell(
+                m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
+                m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, mask,
+                not s.slot_bonded[p, j], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
+            )
+        sc.track_point_u[k] = yu
+        sc.track_point_w[k] = yw
+        sc.track_depth_shift[k] = shift
         sc.dashpot_cn[k] = 0.0
         sc.dashpot_force[k, 0] = 0.0
         sc.dashpot_force[k, 1] = 0.0
@@ -280,14 +264,21 @@ def _law_range(
         sc.contact_force[k, 0] = 0.0
         sc.contact_force[k, 1] = 0.0
         sc.contact_force[k, 2] = 0.0
-        full_area = sc.track_area[k]
+        if full_area == 0.0 and s.slot_area[p, j] == 0.0 and not s.slot_bonded[p, j]:
+            # Uncovered now and at the last step, unbonded: nothing acts (the opened case below,
+            # without computing what it does not use).
+            sc.track_area[k] = 0.0
+            s.slot_overlap[p, j] = min(-(fm.h0 + fm.hu * yu + fm.hw * yw) + shift, 0.0)
+            s.slot_shear[p, j, 0] = 0.0
+            s.slot_shear[p, j, 1] = 0.0
+            s.slot_shear[p, j, 2] = 0.0
+            s.slot_normal_force[p, j] = 0.0
+            continue
         area = full_area
         if blending:  # this side's share (kernels.blend); 0 switches it off
             area *= wgt
-            sc.track_area[k] = area
-        yu = sc.track_point_u[k]
-        yw = sc.track_point_w[k]
-        un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + sc.track_depth_shift[k]
+        sc.track_area[k] = area
+        un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + shift
         un_prev = s.slot_overlap[p, j]
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
@@ -347,14 +338,15 @@ def _law_range(
             ramp = ramp_overlap(un, un_prev, vn, dt) / un
         f_applied = fn * ramp
         us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
-        trial = ksa * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2)
         if bonded:
             fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)
         else:
             fmax = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn)
-        slipping = trial > fmax
+        trial_sq = ksa * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
+        slipping = trial_sq > fmax * fmax  # |trial force| > fmax (>= 0), without its square root
         gone = False
         if slipping:
+            trial = math.sqrt(trial_sq)
             e_fric += slip_dissipation(ksa, fmax / trial, e0_du, e0_sq, du_sq)
             if bonded:
                 # Shear failure: drop to the residual strength; the released energy is the bond's.
@@ -378,7 +370,7 @@ def _law_range(
         s.slot_normal_force[p, j] = fn
         if gone:
             continue
-        elastic += spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa)
+        elastic += 0.5 * (fn * un + ksa * (us0 * us0 + us1 * us1 + us2 * us2))  # the springs' energies (shear after any slip)
         if blending:
             u_side += 0.5 * kn * full_area * un * un
         active += 1
@@ -408,11 +400,19 @@ def _law_range(
         sc.dashpot_force[k, 1] = d1
         sc.dashpot_force[k, 2] = d2
         fs = ksa * ramp
-        _store(
-            sc.contact_force, sc.contact_point, k,
-            f_applied * n0 + fs * us0 + d0, f_applied * n1 + fs * us1 + d1, f_applied * n2 + fs * us2 + d2,
-            x0, x1, x2,
-        )
+        f0 = f_applied * n0 + fs * us0 + d0
+        f1 = f_applied * n1 + fs * us1 + d1
+        f2 = f_applied * n2 + fs * us2 + d2
+        _store(sc.contact_force, sc.contact_point, k, f0, f1, f2, x0, x1, x2)
+        # The range's resultant on block o and its moment about o's centroid, applied once below.
+        r0, r1, r2 = x0 - s.position[o, 0], x1 - s.position[o, 1], x2 - s.position[o, 2]
+        sf0 += f0
+        sf1 += f1
+        sf2 += f2
+        sm0 += r1 * f2 - r2 * f1
+        sm1 += r2 * f0 - r0 * f2
+        sm2 += r0 * f1 - r1 * f0
+    _apply_resultant(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, sf0, sf1, sf2, sm0, sm1, sm2)
     return elastic, active, e_fric, e_bond, nrel, u_side
 
 
@@ -521,6 +521,7 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
             c1 += d1
             c2 += d2
         _store(sc.contact_force, sc.contact_point, k, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
+        _apply(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, fnc * n0 + c0, fnc * n1 + c1, fnc * n2 + c2, x0, x1, x2)
         s.slot_shear[p, j, 0] = 0.0
         s.slot_shear[p, j, 1] = 0.0
         s.slot_shear[p, j, 2] = 0.0
@@ -674,9 +675,6 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
         if m.block_free[b]:
             for i in range(3):
                 sc.force[b, i] = m.block_mass[b] * (m.gravity[i] + sc.body_acc[i])
-    npend = _cover_pass(m, s, sc)
-    if npend > 0:
-        _partial_pass(m, s, sc, npend)
     elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt)
     if nrel > 0:
         e_fric += _release_pass(m, s, sc, nrel, dt)

@@ -164,6 +164,17 @@ def _dashpot(s: State, sc: Scratch, i: int, k: int, edge: bool) -> tuple[float, 
     )
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def has_dashpots(m: ModelArrays) -> bool:
+    """Whether any pair of joint groups has SP damping (beta > 0); without, no block is damped and
+    the passes over the contacts below are skipped."""
+    for i in range(m.mat_beta.shape[0]):
+        for j in range(m.mat_beta.shape[1]):
+            if m.mat_beta[i, j] > 0.0:
+                return True
+    return False
+
+
 @njit(cache=True, _nrt=False)
 def mark_damped(m: ModelArrays, s: State, sc: Scratch) -> bool:
     """Flag the free blocks with an active dashpot (``sc.block_damped``) and add every dashpot's

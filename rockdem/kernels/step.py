@@ -24,7 +24,7 @@ from numba import njit
 from .bound import contact_bound
 from .detect import detect, update_rotations
 from .forces import compute_forces
-from .implicit import couple, factor_block, finalize, mark_damped, solve_block, sweep
+from .implicit import couple, factor_block, finalize, has_dashpots, mark_damped, solve_block, sweep
 from .layout import (
     DASHPOTS_EXPLICIT,
     DASHPOTS_IMPLICIT,
@@ -168,7 +168,7 @@ def integrate_velocities(
     # interpolated (their mean when the two steps are equal; dt is their mean).
     w_new = 1.0 - 0.5 * step / dt
     w_old = 1.0 - w_new
-    implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
+    implicit = s.dashpots[0] == DASHPOTS_IMPLICIT and has_dashpots(m)
     coupled = False
     it = sc.block_iterate[0]
     if implicit:
@@ -188,7 +188,7 @@ def integrate_velocities(
         if not m.block_free[b]:
             continue
         r = sc.rotation[b]
-        damped = sc.block_damped[b]
+        damped = implicit and sc.block_damped[b]
         mass = m.block_mass[b]
         va = sc.velocity_mid[b]
         for i in range(3):
