@@ -168,8 +168,10 @@ class Start(NamedTuple):
 def prepare_start(model: Model, *, timestep_rule: str = "bound", safety: float = DEFAULT_SAFETY,
                   resolution: float = DEFAULT_RESOLUTION, dt: float | None = None, dashpots: str | None = None) -> Start:
     """The :class:`Start` of a run of ``model`` with these timestep options."""
-    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt, dashpots=dashpots)
-    return Start(info, *initial_state(model))
+    state, scratch = initial_state(model)
+    info = stable_timestep(model, rule=timestep_rule, safety=safety, resolution=resolution, dt=dt, dashpots=dashpots,
+                           initial=(state, scratch))
+    return Start(info, state, scratch)
 
 
 class RunOutput(NamedTuple):
@@ -385,19 +387,21 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     safety = DEFAULT_SAFETY if safety is None else safety
     resolution = DEFAULT_RESOLUTION if resolution is None else resolution
     snaps = ContactSnapshots(model, contact_interval)
+    fresh = None
     if start is not None:
         info = start.timestep
         if dashpots is not None and resolve_dashpots(model, dashpots) != info.dashpots:
             raise ValueError(f"dashpots = {dashpots!r} differs from the prepared start's ({info.dashpots!r})")
     else:
+        fresh = initial_state(model) if ck is None else None
         info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
-                               dashpots=dashpots)
+                               dashpots=dashpots, initial=fresh)
     _check_step_count(info, duration, max_steps)
     rec = _frames(model, duration, interval)
     if start is not None:
         state, scratch = start.state, start.scratch
-    elif ck is None:
-        state, scratch = initial_state(model)
+    elif fresh is not None:
+        state, scratch = fresh
     else:
         ck.check_model(model)
         state, scratch = ck.engine_arrays(model)

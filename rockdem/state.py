@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels.detect import detect, update_rotations
-from .kernels.faces import cover, face_map
+from .kernels.detect import bond_touching, detect, update_rotations
 from .kernels.layout import ENERGY_COUNT, FAILED_NONE, SLOTS, Scratch, State
 from .model import Model
 
@@ -208,24 +207,5 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
             f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.4g} m at the "
             f"start (tolerance {m.touch_tol:.3g} m); move them apart so that they at most touch"
         )
-    for i in range(int(s.pair_count[0])):
-        if s.pair_kind[i] != 0:
-            continue
-        for k in range(int(s.pair_track_start[i]), int(s.pair_track_stop[i])):
-            # The owner's points on the target face; the target's (kernels.blend) on the owner face.
-            fo, ft = int(s.pair_owner_face[i]), int(s.pair_target_face[i])
-            if k >= s.pair_track_split[i]:
-                fo, ft = ft, fo
-            fm = face_map(m, s, sc, fo, ft)
-            if abs(fm.det) < 1e-9:
-                continue
-            p, j = divmod(int(s.track[k]), SLOTS)
-            area, yu, yw, shift = cover(m, sc, p, ft, fm, 0.0)
-            gap = fm.h0 + fm.hu * yu + fm.hw * yw - shift
-            touching = area > 0.0 and abs(gap) <= m.touch_tol
-            s.slot_bonded[p, j] = touching and bool(m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[int(s.slot_partner[p, j])]])
-            s.slot_area[p, j] = area
-            s.slot_overlap[p, j] = -gap
-        codes = s.track[int(s.pair_track_start[i]) : int(s.pair_track_stop[i])]
-        sc.pair_bonded[i] = codes.size > 0 and bool(s.slot_bonded.reshape(-1)[codes].all())
+    bond_touching(m, s, sc)
     return s, sc

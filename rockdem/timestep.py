@@ -35,7 +35,7 @@ import numpy as np
 
 from .kernels.bound import contact_bound
 from .kernels.contact import sp_critical_factor
-from .kernels.layout import DASHPOTS_EXPLICIT, DASHPOTS_IMPLICIT
+from .kernels.layout import DASHPOTS_EXPLICIT, DASHPOTS_IMPLICIT, Scratch, State
 from .model import Model
 from .state import initial_state
 
@@ -114,30 +114,45 @@ class TimestepInfo:
 
 
 def _all_faces_bound(model: Model, sp_reduction: bool) -> tuple[float, float, float]:
-    """Critical step if every interface point of every free block touched a fixed partner."""
+    """Critical step if every interface point of every free block touched a fixed partner: per free
+    block, omega^2 = c sum_points A (kn f(n) + ks (f(t1) + f(t2))), f(d) = 1/m + (r x d)^2 . I^-1 the
+    flexibility of the point along d (n its face normal, t1, t2 tangents; c = 2 with several free
+    blocks), kn, ks, beta the largest of the block's group; returns (2 / omega f_SP, omega, f_SP) of
+    the block with the smallest step (the first one on ties), computed for all blocks at once."""
     m = model.arrays
     groups = np.unique(m.block_group)
     coupling = 2.0 if int(np.count_nonzero(m.block_free)) > 1 else 1.0
     face_of_point = np.repeat(np.arange(len(m.face_area)), np.diff(m.face_point_start))
-    best = (np.inf, 0.0, 1.0)
-    for b in np.flatnonzero(m.block_free):
-        g = m.block_group[b]
-        kn, ks = float(np.max(m.mat_kn[g, groups])), float(np.max(m.mat_ks[g, groups]))
-        beta = float(np.max(m.mat_beta[g, groups]))
-        sel = m.point_block == b
-        r, area, n = m.point_local[sel], m.point_area[sel], m.face_normal[face_of_point[sel]]
-        t1 = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
-        t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-        t2 = np.cross(n, t1)
+    nb = len(m.block_mass)
+    g = m.block_group
+    kn = np.max(m.mat_kn[g][:, groups], axis=1)  # (nb,) the largest over the groups present
+    ks = np.max(m.mat_ks[g][:, groups], axis=1)
+    beta = np.max(m.mat_beta[g][:, groups], axis=1)
+    pb = m.point_block
+    sel = m.block_free[pb]
+    pb, r, area, n = pb[sel], m.point_local[sel], m.point_area[sel], m.face_normal[face_of_point[sel]]
+    t1 = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(n, t1)
+    with np.errstate(divide="ignore"):
+        inv_mass, inv_inertia = 1.0 / m.block_mass[pb], 1.0 / m.block_inertia[pb]
 
-        def flex(d: np.ndarray) -> np.ndarray:
-            return 1.0 / m.block_mass[b] + (np.cross(r, d) ** 2) @ (1.0 / m.block_inertia[b])
+    def flex(d: np.ndarray) -> np.ndarray:
+        return inv_mass + np.sum(np.cross(r, d) ** 2 * inv_inertia, axis=1)
 
-        w = math.sqrt(coupling * float(np.sum(area * (kn * flex(n) + ks * (flex(t1) + flex(t2))))))
-        f = sp_critical_factor(beta, w) if sp_reduction else 1.0
-        if 2.0 / w * f < best[0]:
-            best = (2.0 / w * f, w, f)
-    return best
+    terms = area * (kn[pb] * flex(n) + ks[pb] * (flex(t1) + flex(t2)))
+    free = np.flatnonzero(m.block_free)
+    if free.size == 0:
+        return (np.inf, 0.0, 1.0)
+    w = np.sqrt(coupling * np.bincount(pb, weights=terms, minlength=nb)[free])
+    with np.errstate(divide="ignore"):
+        xi = 0.5 * beta[free] * w
+        f = 1.0 / (np.hypot(1.0, xi) + xi) if sp_reduction else np.ones_like(w)  # kernels.contact.sp_critical_factor
+        steps = 2.0 / w * f
+    best = int(np.argmin(steps))
+    if not steps[best] < np.inf:
+        return (np.inf, 0.0, 1.0)
+    return (float(steps[best]), float(w[best]), float(f[best]))
 
 
 def stable_timestep(
@@ -148,8 +163,10 @@ def stable_timestep(
     resolution: float = DEFAULT_RESOLUTION,
     dt: float | None = None,
     dashpots: str | None = None,
+    initial: tuple[State, Scratch] | None = None,
 ) -> TimestepInfo:
-    """Timestep for ``model`` at its initial state.
+    """Timestep for ``model`` at its initial state (``initial``: that state and scratch when the
+    caller has them, :func:`rockdem.state.initial_state`; computed here otherwise).
 
     Args:
         rule: "bound" (default) or "3dec".
@@ -171,7 +188,7 @@ def stable_timestep(
         raise ValueError(f"timestep safety must lie in (0, 1], got {safety!r}")
     if not (math.isfinite(resolution) and 0.0 < resolution <= 1.0):
         raise ValueError(f"timestep resolution must lie in (0, 1], got {resolution!r}")
-    s, sc = initial_state(model)
+    s, sc = initial_state(model) if initial is None else initial
     critical, om, fac = (float(v) for v in contact_bound(model.arrays, s, sc, explicit))
     free_fall = _all_faces_bound(model, explicit)
     if not math.isfinite(critical):

@@ -526,3 +526,37 @@ def _release_lost_edges(m: ModelArrays, s: State, sc: Scratch) -> None:
         fn = sc.prev_pair_normal_force[k]
         e += 0.5 * fn * fn / (m.mat_kn[g0, g1] * area)
         s.energy[E_FRICTION] += e
+
+
+@njit(cache=True, _nrt=False)
+def bond_touching(m: ModelArrays, s: State, sc: Scratch) -> None:
+    """At the start: the effective area and overlap of every tracked sub-contact, bonded where its
+    cell is covered and its gap is within ``m.touch_tol`` and the two groups' material bonds
+    (``m.mat_bonded``); a FACE pair whose sub-contacts are all bonded is a joint
+    (``sc.pair_bonded``, no blending)."""
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] != PAIR_FACE:
+            continue
+        k0 = s.pair_track_start[i]
+        k1 = s.pair_track_stop[i]
+        for k in range(k0, k1):
+            # The owner's points on the target face; the target's (kernels.blend) on the owner face.
+            fo, ft = s.pair_owner_face[i], s.pair_target_face[i]
+            if k >= s.pair_track_split[i]:
+                fo, ft = ft, fo
+            fm = face_map(m, s, sc, fo, ft)
+            if abs(fm.det) < 1e-9:
+                continue
+            p = s.track[k] // SLOTS
+            j = s.track[k] - SLOTS * p
+            area, yu, yw, shift = cover(m, sc, p, ft, fm, 0.0)
+            gap = fm.h0 + fm.hu * yu + fm.hw * yw - shift
+            touching = area > 0.0 and abs(gap) <= m.touch_tol
+            s.slot_bonded[p, j] = touching and m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[s.slot_partner[p, j]]]
+            s.slot_area[p, j] = area
+            s.slot_overlap[p, j] = -gap
+        joint = k1 > k0
+        for k in range(k0, k1):
+            p = s.track[k] // SLOTS
+            joint = joint and s.slot_bonded[p, s.track[k] - SLOTS * p]
+        sc.pair_bonded[i] = joint
