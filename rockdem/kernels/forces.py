@@ -67,36 +67,6 @@ def _store(force: np.ndarray, point: np.ndarray, k: int, f0: float, f1: float, f
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _apply(
-    position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
-    o: int, t: int, f0: float, f1: float, f2: float, c0: float, c1: float, c2: float,
-) -> None:
-    """Force f on block o and -f on block t, both at world point c; the reaction of driven blocks."""
-    r0, r1, r2 = c0 - position[o, 0], c1 - position[o, 1], c2 - position[o, 2]
-    q0, q1, q2 = c0 - position[t, 0], c1 - position[t, 1], c2 - position[t, 2]
-    force[o, 0] += f0
-    force[o, 1] += f1
-    force[o, 2] += f2
-    force[t, 0] -= f0
-    force[t, 1] -= f1
-    force[t, 2] -= f2
-    torque[o, 0] += r1 * f2 - r2 * f1
-    torque[o, 1] += r2 * f0 - r0 * f2
-    torque[o, 2] += r0 * f1 - r1 * f0
-    torque[t, 0] -= q1 * f2 - q2 * f1
-    torque[t, 1] -= q2 * f0 - q0 * f2
-    torque[t, 2] -= q0 * f1 - q1 * f0
-    if free[o] and not free[t]:
-        reaction[0] += f0
-        reaction[1] += f1
-        reaction[2] += f2
-    elif free[t] and not free[o]:
-        reaction[0] -= f0
-        reaction[1] -= f1
-        reaction[2] -= f2
-
-
-@njit(cache=True, _nrt=False, inline="always")
 def _apply_resultant(
     position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
     o: int, t: int, f0: float, f1: float, f2: float, m0: float, m1: float, m2: float,
@@ -126,6 +96,16 @@ def _apply_resultant(
         reaction[0] -= f0
         reaction[1] -= f1
         reaction[2] -= f2
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _apply(
+    position: np.ndarray, free: np.ndarray, force: np.ndarray, torque: np.ndarray, reaction: np.ndarray,
+    o: int, t: int, f0: float, f1: float, f2: float, c0: float, c1: float, c2: float,
+) -> None:
+    """Force f on block o and -f on block t, both at world point c; the reaction of driven blocks."""
+    r0, r1, r2 = c0 - position[o, 0], c1 - position[o, 1], c2 - position[o, 2]
+    _apply_resultant(position, free, force, torque, reaction, o, t, f0, f1, f2, r1 * f2 - r2 * f1, r2 * f0 - r0 * f2, r0 * f1 - r1 * f0)
 
 
 @njit(cache=True, _nrt=False)
