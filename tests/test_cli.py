@@ -1,5 +1,7 @@
 """The command line as a user runs it: the built-in example end to end, and bad input."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -164,6 +166,21 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
         assert (out / "result.nc").exists() == saved
         if not saved:
             assert "stopped by SIGINT" in err
+
+
+def test_only_the_program_freezes_its_objects_before_exit(monkeypatch):
+    # main() as the program (argv None) freezes what is left for a fast interpreter exit; called
+    # with an argument list (from Python, as here) it leaves the garbage collector alone
+    import gc
+
+    monkeypatch.setattr(sys, "argv", ["rockdem", "--version"])
+    assert main(["--version"]) == 0
+    assert gc.get_freeze_count() == 0
+    try:
+        assert main() == 0
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
 
 
 def test_command_modules_without_a_command_are_skipped(monkeypatch):
