@@ -413,12 +413,34 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out["block_free"] = out["block_free"].astype(np.int8)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
     try:
-        out.to_netcdf(tmp, encoding=enc)
+        _write_netcdf(out, tmp, enc)
         os.replace(tmp, p)  # atomic on one file system; replaces a link at p, not its target
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     return p
+
+
+def _write_netcdf(ds: xr.Dataset, path: Path, encoding: Mapping[str, Mapping[str, Any]]) -> None:
+    """``ds.to_netcdf(path, encoding=encoding)``: the same NetCDF4 file, byte for byte, written
+    through xarray's store with the lock that serialises netCDF-C and HDF5 calls across threads,
+    without to_netcdf's query of the dask scheduler for a per-file lock, which imports
+    ``distributed`` wherever dask is installed (0.2 s, a tenth of a warm ``rockdem run``). A
+    dataset holding dask arrays (or an xarray without that lock) goes through to_netcdf."""
+    from xarray.backends import NetCDF4DataStore
+
+    try:
+        from xarray.backends.netCDF4_ import NETCDF4_PYTHON_LOCK as lock
+    except ImportError:
+        lock = None
+    if lock is None or any(v.chunks is not None for v in ds.variables.values()):
+        ds.to_netcdf(path, encoding=encoding)
+        return
+    store = NetCDF4DataStore.open(path, mode="w", lock=lock)
+    try:
+        ds.dump_to_store(store, encoding=encoding, unlimited_dims=ds.encoding.get("unlimited_dims"))
+    finally:
+        store.close()
 
 
 def load(path: str | Path) -> xr.Dataset:

@@ -96,13 +96,13 @@ def test_interrupted_save_leaves_no_truncated_file(tmp_path, monkeypatch):
     # exist), never hold a partial file that still opens; no temporary file is left behind.
     ds = _small_result()
     dest = tmp_path / "result.nc"
-    real = xr.Dataset.to_netcdf
+    real = xr.Dataset.dump_to_store
 
-    def interrupted(self, path, *args, **kwargs):
-        real(self.isel(time=[0]), path)  # a valid but incomplete file on disk...
+    def interrupted(self, store, **kwargs):
+        real(self.isel(time=[0]), store)  # a valid but incomplete file on disk...
         raise KeyboardInterrupt  # ...then the interruption
 
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
+    monkeypatch.setattr(xr.Dataset, "dump_to_store", interrupted)
     with pytest.raises(KeyboardInterrupt):
         save(ds, dest)
     assert not dest.exists()
@@ -111,9 +111,39 @@ def test_interrupted_save_leaves_no_truncated_file(tmp_path, monkeypatch):
         save(ds, dest)
     assert dest.read_bytes() == b"previous result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["result.nc"]
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", real)
+    monkeypatch.setattr(xr.Dataset, "dump_to_store", real)
     save(ds, dest)
     assert load(dest).sizes["time"] == ds.sizes["time"]
+
+
+def test_save_writes_the_bytes_of_xarrays_to_netcdf_without_importing_distributed(tmp_path, monkeypatch):
+    # save() writes through the NetCDF4 store directly: the file must be the one Dataset.to_netcdf
+    # writes, byte for byte; and a process that saves does not import dask.distributed (0.2 s)
+    import subprocess
+    import sys
+
+    import rockdem.results
+
+    ds = _small_result()
+    save(ds, tmp_path / "direct.nc")
+    monkeypatch.setattr(rockdem.results, "_write_netcdf", lambda d, path, encoding: d.to_netcdf(path, encoding=encoding))
+    save(ds, tmp_path / "xarray.nc")
+    assert (tmp_path / "direct.nc").read_bytes() == (tmp_path / "xarray.nc").read_bytes()
+    pytest.importorskip("distributed")
+    code = ("import sys; from rockdem.results import load, save; "
+            f"save(load({str(tmp_path / 'direct.nc')!r}), {str(tmp_path / 'again.nc')!r}); "
+            "print('distributed' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+    assert out.stdout.strip() == "False"
+    xr.testing.assert_identical(load(tmp_path / "again.nc"), load(tmp_path / "direct.nc"))
+
+
+def test_save_computes_a_result_held_as_dask_arrays(tmp_path):
+    pytest.importorskip("dask")
+    ds = _small_result()
+    save(ds.chunk({"time": 1}), tmp_path / "chunked.nc")
+    save(ds, tmp_path / "plain.nc")
+    xr.testing.assert_identical(load(tmp_path / "chunked.nc"), load(tmp_path / "plain.nc"))
 
 
 def test_save_replaces_a_symlink_instead_of_writing_through_it(tmp_path):
