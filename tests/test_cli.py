@@ -168,17 +168,31 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
             assert "stopped by SIGINT" in err
 
 
-def test_only_the_program_freezes_its_objects_before_exit(monkeypatch):
-    # main() as the program (argv None) freezes what is left for a fast interpreter exit; called
-    # with an argument list (from Python, as here) it leaves the garbage collector alone
+def test_only_the_program_freezes_its_objects(monkeypatch):
+    # main() as the program (argv None) freezes the objects of the imported modules before the
+    # command runs, and what is left after it (a fast interpreter exit); called with an argument
+    # list (from Python, as here) it leaves the garbage collector alone
     import gc
 
-    monkeypatch.setattr(sys, "argv", ["rockdem", "--version"])
-    assert main(["--version"]) == 0
-    assert gc.get_freeze_count() == 0
+    import rockdem.run_cli
+
+    seen, made = [], []
+
+    def command(args):
+        seen.append(gc.get_freeze_count())
+        made.append([])  # an object of the command, alive at the end
+        return 0
+
+    def frozen(obj):  # the permanent generation is not among gc.get_objects()
+        return not any(o is obj for o in gc.get_objects())
+
+    monkeypatch.setattr(rockdem.run_cli, "_run", command)
+    monkeypatch.setattr(sys, "argv", ["rockdem", "run", "--list-examples"])
+    assert main(["run", "--list-examples"]) == 0
+    assert seen == [0] and gc.get_freeze_count() == 0 and not frozen(made[0])
     try:
         assert main() == 0
-        assert gc.get_freeze_count() > 0
+        assert seen[1] > 0 and frozen(made[1])
     finally:
         gc.unfreeze()
 
