@@ -83,6 +83,36 @@ def test_csv_labels_relative_columns_and_adds_the_ground(runs, tmp_path):
     assert "top.ux rel. ground [m]" in header and "ground.ux [m]" in header and "top.ux [m]" not in header
 
 
+def test_csv_is_the_file_pandas_writes(runs, tmp_path):
+    # export_csv formats the numbers itself: the bytes of pandas' to_csv for the histories of a run,
+    # and for random columns: every float64 magnitude, random bit patterns, NaN (an empty field),
+    # infinities, -0.0, integers, float32 and booleans; header names that need quoting
+    import pandas as pd
+
+    from rockdem.results import _write_csv
+
+    path = export_csv(runs["foundation"], tmp_path / "h.csv")
+    table = pd.read_csv(path)
+    pd.DataFrame({c: table[c].to_numpy() for c in table.columns}).to_csv(tmp_path / "pandas.csv", index=False)
+    assert path.read_bytes() == (tmp_path / "pandas.csv").read_bytes()
+    rng = np.random.default_rng(7)
+    n = 5000
+    bits = rng.integers(0, 2**64, size=n, dtype=np.uint64).view(np.float64)
+    special = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e16, 1e-5, 1e-4, 0.1, 123456789.0])
+    cols = {
+        "time [s]": np.linspace(0.0, 10.0, n),
+        "scaled": rng.normal(size=n) * 10.0 ** rng.integers(-30, 30, size=n),
+        'bits, "raw"': bits,
+        "special": rng.choice(special, size=n),
+        "count [-]": rng.integers(-(2**40), 2**40, size=n),
+        "single": rng.normal(size=n).astype(np.float32),
+        "flag": rng.uniform(size=n) < 0.5,
+    }
+    _write_csv(tmp_path / "mine.csv", cols)
+    pd.DataFrame(cols).to_csv(tmp_path / "theirs.csv", index=False)
+    assert (tmp_path / "mine.csv").read_bytes() == (tmp_path / "theirs.csv").read_bytes()
+
+
 def _small_result() -> xr.Dataset:
     bld = ModelBuilder(points=(2, 2))
     bld.default_material = JointMaterial(kn=E / H, friction_angle=80.0)
