@@ -168,10 +168,10 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
             assert "stopped by SIGINT" in err
 
 
-def test_only_the_program_freezes_its_objects(monkeypatch):
-    # main() as the program (argv None) freezes the objects of the imported modules before the
-    # command runs, and what is left after it (a fast interpreter exit); called with an argument
-    # list (from Python, as here) it leaves the garbage collector alone
+def test_only_the_program_pauses_and_freezes_the_garbage_collector(monkeypatch):
+    # main() as the program (argv None) imports the command's modules with the collector paused,
+    # freezes their objects before the command runs (collector on again) and what is left after it
+    # (a fast interpreter exit); with an argument list (from Python, as here) it leaves it alone
     import gc
 
     import rockdem.run_cli
@@ -186,13 +186,16 @@ def test_only_the_program_freezes_its_objects(monkeypatch):
     def frozen(obj):  # the permanent generation is not among gc.get_objects()
         return not any(o is obj for o in gc.get_objects())
 
+    collecting = []  # whether the collector runs while the command's modules are imported
+    add_commands = rockdem.cli._add_commands
+    monkeypatch.setattr(rockdem.cli, "_add_commands", lambda *a: collecting.append(gc.isenabled()) or add_commands(*a))
     monkeypatch.setattr(rockdem.run_cli, "_run", command)
     monkeypatch.setattr(sys, "argv", ["rockdem", "run", "--list-examples"])
     assert main(["run", "--list-examples"]) == 0
-    assert seen == [0] and gc.get_freeze_count() == 0 and not frozen(made[0])
+    assert seen == [0] and gc.get_freeze_count() == 0 and not frozen(made[0]) and collecting == [True]
     try:
         assert main() == 0
-        assert seen[1] > 0 and frozen(made[1])
+        assert seen[1] > 0 and frozen(made[1]) and collecting == [True, False] and gc.isenabled()
     finally:
         gc.unfreeze()
 
