@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import importlib
 import math
 import signal
@@ -182,9 +183,33 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``rockdem`` console script; returns the exit status (see the module)."""
+    """Entry point of the ``rockdem`` console script; returns the exit status (see the module).
+
+    Run as the program (``argv`` None: the command line is ``sys.argv``), the garbage collector is
+    paused while the command's modules are imported (NumPy, xarray, SciPy, Numba: ~10^5 objects,
+    kept to the end, hardly any garbage), then their objects, and again those alive at the end, are
+    frozen (:func:`gc.freeze`): no collection scans them, during the command or at the
+    interpreter's exit (0.1 s + 0.1 s + 0.4 s of a warm ``rockdem run``). Objects held only by
+    reference cycles are then not finalized at exit, which Python does not promise anyway; the
+    commands close their files themselves.
+    """
+    status = _main(argv)
+    if argv is None:
+        gc.freeze()
+    return status
+
+
+def _main(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else argv
-    parser = build_parser(next((w for w in words if not w.startswith("-")), None))  # top-level flags take no value
+    program = argv is None
+    if program:
+        gc.disable()  # the imports' objects live to the end: no collections over them as they load
+    try:
+        parser = build_parser(next((w for w in words if not w.startswith("-")), None))  # top-level flags take no value
+    finally:
+        if program:
+            gc.freeze()
+            gc.enable()
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse: --help, --version (0) or a bad flag (2, message printed)

@@ -47,6 +47,7 @@ unaffected by a translating ground. A command-line summary of peak displacements
 
 from __future__ import annotations
 
+import csv
 import os
 import uuid
 from pathlib import Path
@@ -413,12 +414,34 @@ def save(ds: xr.Dataset, path: str | Path) -> Path:
     out["block_free"] = out["block_free"].astype(np.int8)
     tmp = p.with_name(f".{p.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.part")
     try:
-        out.to_netcdf(tmp, encoding=enc)
+        _write_netcdf(out, tmp, enc)
         os.replace(tmp, p)  # atomic on one file system; replaces a link at p, not its target
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
     return p
+
+
+def _write_netcdf(ds: xr.Dataset, path: Path, encoding: Mapping[str, Mapping[str, Any]]) -> None:
+    """``ds.to_netcdf(path, encoding=encoding)``: the same NetCDF4 file, byte for byte, written
+    through xarray's store with the lock that serialises netCDF-C and HDF5 calls across threads,
+    without to_netcdf's query of the dask scheduler for a per-file lock, which imports
+    ``distributed`` wherever dask is installed (0.2 s, a tenth of a warm ``rockdem run``). A
+    dataset holding dask arrays (or an xarray without that lock) goes through to_netcdf."""
+    from xarray.backends import NetCDF4DataStore
+
+    try:
+        from xarray.backends.netCDF4_ import NETCDF4_PYTHON_LOCK as lock
+    except ImportError:
+        lock = None
+    if lock is None or any(v.chunks is not None for v in ds.variables.values()):
+        ds.to_netcdf(path, encoding=encoding)
+        return
+    store = NetCDF4DataStore.open(path, mode="w", lock=lock)
+    try:
+        ds.dump_to_store(store, encoding=encoding, unlimited_dims=ds.encoding.get("unlimited_dims"))
+    finally:
+        store.close()
 
 
 def load(path: str | Path) -> xr.Dataset:
@@ -467,12 +490,28 @@ def export_csv(ds: xr.Dataset, path: str | Path) -> Path:
         cols[f"base_reaction_{ax} [N]"] = ds.base_reaction.values[:, i]
     for name in ENERGY_NAMES + ("energy_balance_error",):
         cols[f"{name} [J]"] = ds[name].values
-    import pandas as pd
-
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
-    pd.DataFrame(cols).to_csv(p, index=False)
+    _write_csv(p, cols)
     return p
+
+
+def _write_csv(path: Path, columns: Mapping[str, np.ndarray]) -> None:
+    """Write numeric columns (n,) as a CSV table, the file ``pandas.DataFrame(columns).to_csv(path,
+    index=False)`` writes, byte for byte (tested), in half its time: float64 and integers by
+    ``repr`` (the shortest digits that round-trip, as NumPy formats them for pandas), other dtypes
+    by NumPy's ``str``, NaN as an empty field; the header quoted where needed."""
+    text = []
+    for values in columns.values():
+        v = np.asarray(values)
+        col = list(map(repr, v.tolist())) if v.dtype == np.float64 or v.dtype.kind in "iu" else v.astype(str).tolist()
+        if v.dtype.kind == "f":
+            for i in np.flatnonzero(np.isnan(v)).tolist():
+                col[i] = ""
+        text.append(col)
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        csv.writer(fh, lineterminator=os.linesep).writerow(columns)
+        fh.write("".join(",".join(row) + os.linesep for row in zip(*text)))
 
 
 def contact_table(ds: xr.Dataset) -> "pd.DataFrame":

@@ -20,6 +20,7 @@ from rockdem.analysis import (
     lowest_point_height,
     max_rotation,
     overturned,
+    prominent_peaks,
     residual_drift,
     rocking_lift,
     rocking_onset_time,
@@ -113,6 +114,34 @@ def test_half_cycle_peaks_two_sided_and_one_sided() -> None:
     shift = math.atan(0.1 / (2 * np.pi)) / (2 * np.pi)
     np.testing.assert_allclose(two.time[1:], np.arange(1, 6) * 0.5 - shift, atol=1e-6)
     assert two.value[0] == 1.0 and two.value[1] < 0
+
+
+@pytest.mark.parametrize("kind", ["noise", "walk", "plateaus", "rising", "rocking"])
+def test_prominent_peaks_match_scipy_find_peaks(kind: str) -> None:
+    # The NumPy peak finder against SciPy's on random signals, for prominence thresholds from
+    # "every peak" to "only the largest": the same indices. Quantised signals have flat runs
+    # (plateau peaks at their middle sample); a rising sawtooth makes every base reach the start.
+    from scipy.signal import find_peaks
+
+    rng = np.random.default_rng(["noise", "walk", "plateaus", "rising", "rocking"].index(kind))
+    for n in (0, 1, 2, 3, 5, 50, 2001):
+        for _ in range(5):
+            if kind == "noise":
+                x = rng.normal(size=n)
+            elif kind == "walk":
+                x = np.cumsum(rng.normal(size=n))
+            elif kind == "plateaus":
+                x = np.round(np.cumsum(rng.normal(size=n)) * 0.7)
+            elif kind == "rising":
+                x = np.arange(n) * 0.01 + rng.uniform(size=n)
+            else:
+                t = np.linspace(0.0, 10.0, n)
+                x = np.abs(np.exp(-0.3 * t) * np.cos(7.0 * t + rng.uniform(0, 6)) + 1e-3 * rng.normal(size=n))
+            span = float(np.ptp(x)) if n else 1.0
+            for frac in (0.0, 1e-3, 0.02, 0.3, 0.9, 2.0):
+                prom = max(frac * span, np.finfo(float).tiny)
+                expected, _ = find_peaks(x, prominence=prom)
+                np.testing.assert_array_equal(prominent_peaks(x, prom), expected)
 
 
 def test_bouncing_free_flight_parabolas() -> None:

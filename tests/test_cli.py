@@ -1,5 +1,7 @@
 """The command line as a user runs it: the built-in example end to end, and bad input."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -164,6 +166,38 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
         assert (out / "result.nc").exists() == saved
         if not saved:
             assert "stopped by SIGINT" in err
+
+
+def test_only_the_program_pauses_and_freezes_the_garbage_collector(monkeypatch):
+    # main() as the program (argv None) imports the command's modules with the collector paused,
+    # freezes their objects before the command runs (collector on again) and what is left after it
+    # (a fast interpreter exit); with an argument list (from Python, as here) it leaves it alone
+    import gc
+
+    import rockdem.run_cli
+
+    seen, made = [], []
+
+    def command(args):
+        seen.append(gc.get_freeze_count())
+        made.append([])  # an object of the command, alive at the end
+        return 0
+
+    def frozen(obj):  # the permanent generation is not among gc.get_objects()
+        return not any(o is obj for o in gc.get_objects())
+
+    collecting = []  # whether the collector runs while the command's modules are imported
+    add_commands = rockdem.cli._add_commands
+    monkeypatch.setattr(rockdem.cli, "_add_commands", lambda *a: collecting.append(gc.isenabled()) or add_commands(*a))
+    monkeypatch.setattr(rockdem.run_cli, "_run", command)
+    monkeypatch.setattr(sys, "argv", ["rockdem", "run", "--list-examples"])
+    assert main(["run", "--list-examples"]) == 0
+    assert seen == [0] and gc.get_freeze_count() == 0 and not frozen(made[0]) and collecting == [True]
+    try:
+        assert main() == 0
+        assert seen[1] > 0 and frozen(made[1]) and collecting == [True, False] and gc.isenabled()
+    finally:
+        gc.unfreeze()
 
 
 def test_command_modules_without_a_command_are_skipped(monkeypatch):

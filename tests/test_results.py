@@ -83,6 +83,36 @@ def test_csv_labels_relative_columns_and_adds_the_ground(runs, tmp_path):
     assert "top.ux rel. ground [m]" in header and "ground.ux [m]" in header and "top.ux [m]" not in header
 
 
+def test_csv_is_the_file_pandas_writes(runs, tmp_path):
+    # export_csv formats the numbers itself: the bytes of pandas' to_csv for the histories of a run,
+    # and for random columns: every float64 magnitude, random bit patterns, NaN (an empty field),
+    # infinities, -0.0, integers, float32 and booleans; header names that need quoting
+    import pandas as pd
+
+    from rockdem.results import _write_csv
+
+    path = export_csv(runs["foundation"], tmp_path / "h.csv")
+    table = pd.read_csv(path)
+    pd.DataFrame({c: table[c].to_numpy() for c in table.columns}).to_csv(tmp_path / "pandas.csv", index=False)
+    assert path.read_bytes() == (tmp_path / "pandas.csv").read_bytes()
+    rng = np.random.default_rng(7)
+    n = 5000
+    bits = rng.integers(0, 2**64, size=n, dtype=np.uint64).view(np.float64)
+    special = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1e16, 1e-5, 1e-4, 0.1, 123456789.0])
+    cols = {
+        "time [s]": np.linspace(0.0, 10.0, n),
+        "scaled": rng.normal(size=n) * 10.0 ** rng.integers(-30, 30, size=n),
+        'bits, "raw"': bits,
+        "special": rng.choice(special, size=n),
+        "count [-]": rng.integers(-(2**40), 2**40, size=n),
+        "single": rng.normal(size=n).astype(np.float32),
+        "flag": rng.uniform(size=n) < 0.5,
+    }
+    _write_csv(tmp_path / "mine.csv", cols)
+    pd.DataFrame(cols).to_csv(tmp_path / "theirs.csv", index=False)
+    assert (tmp_path / "mine.csv").read_bytes() == (tmp_path / "theirs.csv").read_bytes()
+
+
 def _small_result() -> xr.Dataset:
     bld = ModelBuilder(points=(2, 2))
     bld.default_material = JointMaterial(kn=E / H, friction_angle=80.0)
@@ -96,13 +126,13 @@ def test_interrupted_save_leaves_no_truncated_file(tmp_path, monkeypatch):
     # exist), never hold a partial file that still opens; no temporary file is left behind.
     ds = _small_result()
     dest = tmp_path / "result.nc"
-    real = xr.Dataset.to_netcdf
+    real = xr.Dataset.dump_to_store
 
-    def interrupted(self, path, *args, **kwargs):
-        real(self.isel(time=[0]), path)  # a valid but incomplete file on disk...
+    def interrupted(self, store, **kwargs):
+        real(self.isel(time=[0]), store)  # a valid but incomplete file on disk...
         raise KeyboardInterrupt  # ...then the interruption
 
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
+    monkeypatch.setattr(xr.Dataset, "dump_to_store", interrupted)
     with pytest.raises(KeyboardInterrupt):
         save(ds, dest)
     assert not dest.exists()
@@ -111,9 +141,39 @@ def test_interrupted_save_leaves_no_truncated_file(tmp_path, monkeypatch):
         save(ds, dest)
     assert dest.read_bytes() == b"previous result"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["result.nc"]
-    monkeypatch.setattr(xr.Dataset, "to_netcdf", real)
+    monkeypatch.setattr(xr.Dataset, "dump_to_store", real)
     save(ds, dest)
     assert load(dest).sizes["time"] == ds.sizes["time"]
+
+
+def test_save_writes_the_bytes_of_xarrays_to_netcdf_without_importing_distributed(tmp_path, monkeypatch):
+    # save() writes through the NetCDF4 store directly: the file must be the one Dataset.to_netcdf
+    # writes, byte for byte; and a process that saves does not import dask.distributed (0.2 s)
+    import subprocess
+    import sys
+
+    import rockdem.results
+
+    ds = _small_result()
+    save(ds, tmp_path / "direct.nc")
+    monkeypatch.setattr(rockdem.results, "_write_netcdf", lambda d, path, encoding: d.to_netcdf(path, encoding=encoding))
+    save(ds, tmp_path / "xarray.nc")
+    assert (tmp_path / "direct.nc").read_bytes() == (tmp_path / "xarray.nc").read_bytes()
+    pytest.importorskip("distributed")
+    code = ("import sys; from rockdem.results import load, save; "
+            f"save(load({str(tmp_path / 'direct.nc')!r}), {str(tmp_path / 'again.nc')!r}); "
+            "print('distributed' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+    assert out.stdout.strip() == "False"
+    xr.testing.assert_identical(load(tmp_path / "again.nc"), load(tmp_path / "direct.nc"))
+
+
+def test_save_computes_a_result_held_as_dask_arrays(tmp_path):
+    pytest.importorskip("dask")
+    ds = _small_result()
+    save(ds.chunk({"time": 1}), tmp_path / "chunked.nc")
+    save(ds, tmp_path / "plain.nc")
+    xr.testing.assert_identical(load(tmp_path / "chunked.nc"), load(tmp_path / "plain.nc"))
 
 
 def test_save_replaces_a_symlink_instead_of_writing_through_it(tmp_path):
