@@ -387,21 +387,20 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     safety = DEFAULT_SAFETY if safety is None else safety
     resolution = DEFAULT_RESOLUTION if resolution is None else resolution
     snaps = ContactSnapshots(model, contact_interval)
-    fresh = None
+    if start is None and ck is None:
+        start = prepare_start(model, timestep_rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
+                              dashpots=dashpots)
     if start is not None:
         info = start.timestep
         if dashpots is not None and resolve_dashpots(model, dashpots) != info.dashpots:
             raise ValueError(f"dashpots = {dashpots!r} differs from the prepared start's ({info.dashpots!r})")
     else:
-        fresh = initial_state(model) if ck is None else None
         info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
-                               dashpots=dashpots, initial=fresh)
+                               dashpots=dashpots)
     _check_step_count(info, duration, max_steps)
     rec = _frames(model, duration, interval)
     if start is not None:
         state, scratch = start.state, start.scratch
-    elif fresh is not None:
-        state, scratch = fresh
     else:
         ck.check_model(model)
         state, scratch = ck.engine_arrays(model)

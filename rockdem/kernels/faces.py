@@ -387,21 +387,21 @@ def _lumped_area(
 @njit(cache=True, _nrt=False)
 def cut_cell(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
-    nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, mask: int,
-    lumped: bool, target_cell_area: float,
+    nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
+    mask: int, lumped: bool, target_cell_area: float,
 ) -> tuple[float, float, float, float]:
     """Effective area, force point (u, w) and depth shift of point p's cell (node (nu, nw), area
-    ``point_area``) against target face ``ft`` when target edge lines cross the owner face
-    (``mask``, :func:`crossing_lines`): :func:`covered` against those lines, then
+    ``point_area``) against target face ``ft`` grown by ``grow`` [m], tested against the target
+    edge lines of ``mask`` (:func:`crossing_lines`, or ALL_LINES): :func:`covered`, then
     :func:`partly_covered` (``lumped``, ``target_cell_area`` as there) where the cell is cut.
     Compiled out of line, so that the joint law's loop stays small for flush joints."""
-    state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, 0.0, mask)
+    state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, grow, mask)
     if state == COVER_FULL:
         return point_area, nu, nw, 0.0
     if state == COVER_NONE:
         return 0.0, nu, nw, 0.0
     return partly_covered(
-        cell_start, cell_vertex, line_start, line, buf, nu, nw, point_area, touch_tol, p, ft, fm, 0.0,
+        cell_start, cell_vertex, line_start, line, buf, nu, nw, point_area, touch_tol, p, ft, fm, grow,
         lumped, target_cell_area, mask,
     )
 
@@ -416,12 +416,7 @@ def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float
     taking only the arrays they use: Numba compiles such small functions far better than one
     taking the whole model and scratch tuples, 50 ns instead of 1 us per sub-contact.)
     """
-    state = covered(m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, p, ft, fm, grow, ALL_LINES)
-    if state == COVER_FULL:
-        return m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
-    if state == COVER_NONE:
-        return 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
-    return partly_covered(
+    return cut_cell(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, False, np.inf, ALL_LINES,
+        m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, ALL_LINES, False, np.inf,
     )

@@ -231,7 +231,7 @@ def _law_range(
         else:
             full_area, yu, yw, shift = cut_cell(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
-                m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, mask,
+                m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 not s.slot_bonded[p, j], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
             )
         sc.track_point_u[k] = yu
