@@ -61,7 +61,7 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
     vstart, fstart, estart, dstart = [0], [0], [0], [0]
     edge_vertex, edge_area, dirs = [], [], []
     fblock, fnorm, foff, farea, forig, fu, fw = [], [], [], [], [], [], []
-    cstart, corner, lstart, lines = [0], [], [0], []
+    cstart, corner, corner_uw, lstart, lines = [0], [], [], [0], []
     pstart, ploc, parea, pblock, pface, pnode = [0], [], [], [], [], []
     cellstart, cellv = [0], []
     for b, blk in enumerate(blocks):
@@ -86,6 +86,7 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
             corner.extend(int(v) + base_v for v in fverts)
             cstart.append(len(corner))
             q = np.column_stack(((blk.poly.vertices[fverts] - g.origin) @ g.u, (blk.poly.vertices[fverts] - g.origin) @ g.w))
+            corner_uw.append(q)
             for j in range(len(q)):
                 e = q[(j + 1) % len(q)] - q[j]
                 nrm = np.array([e[1], -e[0]]) / np.hypot(e[0], e[1])  # outward for a CCW ring
@@ -131,6 +132,7 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
         "face_w": np.array(fw),
         "face_corner_start": np.array(cstart, dtype=i64),
         "face_corner": np.array(corner, dtype=i64),
+        "face_corner_uw": np.concatenate(corner_uw),
         "face_line_start": np.array(lstart, dtype=i64),
         "face_line": np.array(lines),
         "face_point_start": np.array(pstart, dtype=i64),

@@ -44,6 +44,17 @@ from .series import interpolate
 
 
 @njit(cache=True, _nrt=False, inline="always")
+def has_dashpots(m: ModelArrays) -> bool:
+    """Whether any pair of joint groups has SP damping (beta > 0); without, no block is damped and
+    the passes over the contacts below are skipped."""
+    for i in range(m.mat_beta.shape[0]):
+        for j in range(m.mat_beta.shape[1]):
+            if m.mat_beta[i, j] > 0.0:
+                return True
+    return False
+
+
+@njit(cache=True, _nrt=False, inline="always")
 def _relative_velocity_arrays(
     position: np.ndarray, velocity: np.ndarray, omega_world: np.ndarray, o: int, t: int, c0: float, c1: float, c2: float
 ) -> tuple[float, float, float]:
@@ -157,6 +168,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
     e_bond = 0.0
     nrel = 0
     implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
+    dashpots = has_dashpots(m)
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
@@ -169,13 +181,13 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
         lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
         # The owner's points on the target face, then (while the pair may blend) the target's on
         # the owner face.
-        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel, implicit)
+        el, ac, ef, eb, nrel, u_owner = _law_range(m, s, sc, i, s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop, dt, nrel, implicit, dashpots)
         elastic += el
         active += ac
         e_fric += ef
         e_bond += eb
         if split < stop:
-            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel, implicit)
+            el, ac, ef, eb, nrel, u_target = _law_range(m, s, sc, i, split, stop, fb, fa, b, a, lam, True, dt, nrel, implicit, dashpots)
             elastic += el
             active += ac
             e_fric += ef
@@ -192,7 +204,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, 
 @njit(cache=True, _nrt=False)
 def _law_range(
     m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool,
+    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool, dashpots: bool,
 ) -> tuple[float, int, float, float, int, float]:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
@@ -210,10 +222,7 @@ def _law_range(
     # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
     # lines that cross the owner face are found once for the pair; with none every cell is wholly
     # covered (a flush joint), with one leaving the face outside none is (faces at right angles too).
-    mask = -2 if abs(fm.det) < 1e-9 else crossing_lines(
-        m.face_corner_start, m.face_corner, m.vertex_local, m.face_origin, m.face_u, m.face_w,
-        m.face_line_start, m.face_line, sc.poly, fo, ft, fm,
-    )
+    mask = -2 if abs(fm.det) < 1e-9 else crossing_lines(m.face_corner_start, m.face_corner_uw, m.face_line_start, m.face_line, fo, ft, fm)
     go = m.block_group[o]
     gt = m.block_group[t]
     kn = m.mat_kn[go, gt]
@@ -233,17 +242,19 @@ def _law_range(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 not s.slot_bonded[p, j], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
+                not s.slot_bonded[p, j] and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
         sc.track_point_u[k] = yu
         sc.track_point_w[k] = yw
         sc.track_depth_shift[k] = shift
-        sc.dashpot_cn[k] = 0.0
-        sc.dashpot_force[k, 0] = 0.0
-        sc.dashpot_force[k, 1] = 0.0
-        sc.dashpot_force[k, 2] = 0.0
-        sc.contact_force[k, 0] = 0.0
-        sc.contact_force[k, 1] = 0.0
-        sc.contact_force[k, 2] = 0.0
+        if dashpots:
+            sc.dashpot_cn[k] = 0.0
+            sc.dashpot_force[k, 0] = 0.0
+            sc.dashpot_force[k, 1] = 0.0
+            sc.dashpot_force[k, 2] = 0.0
+            sc.contact_force[k, 0] = 0.0
+            sc.contact_force[k, 1] = 0.0
+            sc.contact_force[k, 2] = 0.0
         if full_area == 0.0 and s.slot_area[p, j] == 0.0 and not s.slot_bonded[p, j]:
             # Uncovered now and at the last step, unbonded: nothing acts (the opened case below,
             # without computing what it does not use).
@@ -376,14 +387,15 @@ def _law_range(
         d0 = fdn * n0 - bs * vs0
         d1 = fdn * n1 - bs * vs1
         d2 = fdn * n2 - bs * vs2
-        sc.dashpot_force[k, 0] = d0
-        sc.dashpot_force[k, 1] = d1
-        sc.dashpot_force[k, 2] = d2
         fs = ksa * ramp
         f0 = f_applied * n0 + fs * us0 + d0
         f1 = f_applied * n1 + fs * us1 + d1
         f2 = f_applied * n2 + fs * us2 + d2
-        _store(sc.contact_force, sc.contact_point, k, f0, f1, f2, x0, x1, x2)
+        if dashpots:  # read by the dashpot passes only (kernels.implicit, step.dashpot_work)
+            sc.dashpot_force[k, 0] = d0
+            sc.dashpot_force[k, 1] = d1
+            sc.dashpot_force[k, 2] = d2
+            _store(sc.contact_force, sc.contact_point, k, f0, f1, f2, x0, x1, x2)
         # The range's resultant on block o and its moment about o's centroid, applied once below.
         r0, r1, r2 = x0 - s.position[o, 0], x1 - s.position[o, 1], x2 - s.position[o, 2]
         sf0 += f0

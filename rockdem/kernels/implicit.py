@@ -43,7 +43,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .forces import _apply
+from .forces import _apply, has_dashpots
 from .layout import PAIR_EDGE, ModelArrays, Scratch, State
 
 DASHPOT_SWEEP_TOL = 1e-9
@@ -162,17 +162,6 @@ def _dashpot(s: State, sc: Scratch, i: int, k: int, edge: bool) -> tuple[float, 
         sc.dashpot_cn[k], sc.dashpot_cs[k], sc.contact_point[k, 0], sc.contact_point[k, 1], sc.contact_point[k, 2],
         sc.dashpot_normal[k, 0], sc.dashpot_normal[k, 1], sc.dashpot_normal[k, 2],
     )
-
-
-@njit(cache=True, _nrt=False, inline="always")
-def has_dashpots(m: ModelArrays) -> bool:
-    """Whether any pair of joint groups has SP damping (beta > 0); without, no block is damped and
-    the passes over the contacts below are skipped."""
-    for i in range(m.mat_beta.shape[0]):
-        for j in range(m.mat_beta.shape[1]):
-            if m.mat_beta[i, j] > 0.0:
-                return True
-    return False
 
 
 @njit(cache=True, _nrt=False)

@@ -101,6 +101,7 @@ class ModelArrays(NamedTuple):
     face_w: np.ndarray  # (nf, 3) unit axis "along" of the face frame, body frame
     face_corner_start: np.ndarray  # (nf+1,)
     face_corner: np.ndarray  # (nc,) global vertex ids, counter-clockwise seen from outside
+    face_corner_uw: np.ndarray  # (nc, 2) [m] those corners in face coordinates (u, w)
     face_line_start: np.ndarray  # (nf+1,)
     face_line: np.ndarray  # (nl, 3) polygon edges in face coordinates: lu u + lw w <= lo inside
     face_point_start: np.ndarray  # (nf+1,)
@@ -207,6 +208,7 @@ class Scratch(NamedTuple):
     body_acc: np.ndarray  # (3,) [m/s^2]
     driven_velocity: np.ndarray  # (3,) [m/s] prescribed velocity of the driven block being integrated
     omega_world: np.ndarray  # (nb, 3) [rad/s]
+    # Per tracked sub-contact, written only where some joint has SP dashpots (read by their passes):
     contact_force: np.ndarray  # (SLOTS np, 3) [N] force of each tracked sub-contact on its owner, world
     contact_point: np.ndarray  # (SLOTS np, 3) [m] its point of application, world
     dashpot_force: np.ndarray  # (SLOTS np, 3) [N] the SP dashpot part of that force

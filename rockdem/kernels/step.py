@@ -452,7 +452,7 @@ def advance(
         # (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
-        if s.dashpots[0] == DASHPOTS_EXPLICIT:
+        if s.dashpots[0] == DASHPOTS_EXPLICIT and has_dashpots(m):
             dashpot_work(m, s, sc, h)
         integrate_positions(m, s, dt)
         s.dt_prev[0] = dt
