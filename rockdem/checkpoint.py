@@ -47,8 +47,9 @@ from .timestep import TimestepInfo
 __all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
-FORMAT_VERSION = 1
-"""Version of the checkpoint file layout; a file of another version is refused."""
+FORMAT_VERSION = 2
+"""Version of the checkpoint file layout; a file of another version is refused. (2: the model
+hash covers ``ModelArrays.face_corner_uw``, so a version-1 file's hash would not match.)"""
 
 LOADING_FIELDS = frozenset(
     {"block_motion", "motion_start", "motion_time", "motion_velocity", "ground_motion", "body_time",

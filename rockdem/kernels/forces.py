@@ -238,11 +238,12 @@ def _law_range(
         elif mask == -2:
             full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
         else:
+            unbonded = not s.slot_bonded[p, j]
             full_area, yu, yw, shift = cut_cell(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
-                not s.slot_bonded[p, j], m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
-                not s.slot_bonded[p, j] and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
+                unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
+                unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
         sc.track_point_u[k] = yu
         sc.track_point_w[k] = yw
