@@ -2,7 +2,8 @@
 
 Step n, at time t_n = n dt, in a fixed order:
   1. rotations from quaternions; contact detection when any block may have moved half the
-     tracking tolerance since the last one;
+     tracking tolerance since the last one, or an edge-edge pair would now be classified otherwise
+     (:func:`rockdem.kernels.detect.edge_pairs_changed`);
   2. forces at x_n: gravity and body loads, sub-contacts of face pairs and point contacts of edge
      pairs (joint law of paper §3, :mod:`rockdem.kernels.contact`) and SP dashpots on the relative
      velocities of the last half step;
@@ -22,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from .bound import contact_bound
-from .detect import detect, update_rotations
+from .detect import detect, edge_pairs_changed, update_rotations
 from .forces import compute_forces
 from .implicit import couple, factor_block, finalize, has_dashpots, mark_damped, solve_block, sweep
 from .layout import (
@@ -430,7 +431,7 @@ def advance(
         for b in range(m.block_mass.shape[0]):
             if s.fell_off[b] < 0.0:  # blocks that fell off the edge meet nothing more
                 moved = max(moved, s.moved[b])
-        if 2.0 * moved >= m.contact_tol:
+        if 2.0 * moved >= m.contact_tol or edge_pairs_changed(m, s, sc):
             detect(m, s, sc)
             if sc.overflow[0] > 0:
                 for b in range(m.block_mass.shape[0]):
