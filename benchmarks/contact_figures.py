@@ -57,7 +57,7 @@ def area_curve(turn_deg: float = 27.0, kn: float = 1e9, overlap: float = 2e-4, n
         bld.add_block(box(0.4, 0.3, 0.2).transformed(rot, (dx, 0.05, 0.1 - overlap)), name="upper")
         model = bld.finalize(damping=Damping())
         st, sc = initial_state(model, check_overlap=False)
-        compute_forces(model.arrays, st, sc, 0.0, 1e-6, 1e-6)
+        compute_forces(model.arrays, st, sc, 0.0, 1e-6)
         supported.append(float(sc.force[1, 2]) / (kn * overlap))
         corners = np.array([[-0.2, -0.15, 0], [0.2, -0.15, 0], [0.2, 0.15, 0], [-0.2, 0.15, 0]]) @ rot.T
         exact.append(_intersection_area(corners[:, :2] + [dx, 0.05], lower))

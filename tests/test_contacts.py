@@ -117,7 +117,7 @@ def test_supported_area_is_the_face_intersection_and_varies_continuously(turn_de
         bld.add_block(upper, name="upper")
         model = bld.finalize(damping=Damping())
         s, sc = initial_state(model, check_overlap=False)
-        compute_forces(model.arrays, s, sc, 0.0, 1e-6, 1e-6)
+        compute_forces(model.arrays, s, sc, 0.0, 1e-6)
         corners = np.array([[-0.2, -0.15, 0], [0.2, -0.15, 0], [0.2, 0.15, 0], [-0.2, 0.15, 0]]) @ rot.T
         base = corners[:, :2] + [dx, 0.05]
         areas.append(_intersection_area(base, lower))

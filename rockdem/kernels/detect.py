@@ -62,24 +62,27 @@ def update_rotations(m: ModelArrays, s: State, sc: Scratch) -> None:
 
 
 @njit(cache=True, _nrt=False)
+def _block_world_vertices(m: ModelArrays, s: State, sc: Scratch, b: int) -> None:
+    """``sc.world_vertex`` of block b's vertices at its current pose (rotation current)."""
+    r = sc.rotation[b]
+    for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
+        for i in range(3):
+            sc.world_vertex[v, i] = (r[i, 0] * m.vertex_local[v, 0] + r[i, 1] * m.vertex_local[v, 1]
+                                     + r[i, 2] * m.vertex_local[v, 2] + s.position[b, i])
+
+
+@njit(cache=True, _nrt=False)
 def _world_vertices(m: ModelArrays, s: State, sc: Scratch) -> None:
-    nb = m.block_mass.shape[0]
-    for b in range(nb):
-        r = sc.rotation[b]
+    """World vertices of every block and their bounding boxes grown by the tracking tolerance."""
+    for b in range(m.block_mass.shape[0]):
+        _block_world_vertices(m, s, sc, b)
         for i in range(3):
             sc.aabb[b, i] = np.inf
             sc.aabb[b, 3 + i] = -np.inf
         for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
             for i in range(3):
-                x = (
-                    r[i, 0] * m.vertex_local[v, 0]
-                    + r[i, 1] * m.vertex_local[v, 1]
-                    + r[i, 2] * m.vertex_local[v, 2]
-                    + s.position[b, i]
-                )
-                sc.world_vertex[v, i] = x
-                sc.aabb[b, i] = min(sc.aabb[b, i], x)
-                sc.aabb[b, 3 + i] = max(sc.aabb[b, 3 + i], x)
+                sc.aabb[b, i] = min(sc.aabb[b, i], sc.world_vertex[v, i])
+                sc.aabb[b, 3 + i] = max(sc.aabb[b, 3 + i], sc.world_vertex[v, i])
         for i in range(3):
             sc.aabb[b, i] -= m.contact_tol
             sc.aabb[b, 3 + i] += m.contact_tol
@@ -251,16 +254,6 @@ def _incident_face(
         if _face_depth(m, sc, previous, nx, ny, nz) <= _face_depth(m, sc, out, nx, ny, nz) + INCIDENT_KEEP * tol:
             return previous
     return out
-
-
-@njit(cache=True, _nrt=False)
-def _block_world_vertices(m: ModelArrays, s: State, sc: Scratch, b: int) -> None:
-    """``sc.world_vertex`` of block b's vertices at its current pose (rotation current)."""
-    r = sc.rotation[b]
-    for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
-        for i in range(3):
-            sc.world_vertex[v, i] = (r[i, 0] * m.vertex_local[v, 0] + r[i, 1] * m.vertex_local[v, 1]
-                                     + r[i, 2] * m.vertex_local[v, 2] + s.position[b, i])
 
 
 @njit(cache=True, _nrt=False)

@@ -151,7 +151,7 @@ def _faces(s: State, i: int, side: int) -> tuple[int, int]:
 
 
 @njit(cache=True, _nrt=False)
-def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, dt_next: float) -> tuple[float, int, float, float, int]:
+def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
     """The cover and joint law of every sub-contact of the face pairs: stores its force
     and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
     that opened during the last step in ``sc.pending`` for :func:`_release_pass`.
@@ -191,7 +191,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, dt_next: float) 
                 k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
             else:
                 k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
-            el, ac, ef, eb, nrel, u_side = _law_range(m, s, sc, i, k0, k1, fo, ft, o, t, wgt, blending, dt, dt_next, nrel, implicit, dashpots)
+            el, ac, ef, eb, nrel, u_side = _law_range(m, s, sc, i, k0, k1, fo, ft, o, t, wgt, blending, dt, nrel, implicit, dashpots)
             elastic += el
             active += ac
             e_fric += ef
@@ -210,7 +210,7 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, dt_next: float) 
 @njit(cache=True, _nrt=False, inline="always")
 def _law_range(
     m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, dt_next: float, nrel: int, implicit: bool, dashpots: bool,
+    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool, dashpots: bool,
 ) -> tuple[float, int, float, float, int, float]:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
@@ -380,7 +380,7 @@ def _law_range(
             # Implicit dashpots (kernels.implicit): half the force at the last half step's velocity
             # now, the other half at the new velocity in the velocity solve. A contact that closed
             # during the last step has its dashpot from the crossing on.
-            onset = dashpot_onset_share(since, 0.5 * (dt + dt_next)) if closing else 1.0
+            onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
             sc.dashpot_cn[k] = onset * beta * kna
             sc.dashpot_cs[k] = onset * bs
             sc.dashpot_normal[k, 0] = n0
@@ -544,7 +544,7 @@ contact normal: the last normal is kept."""
 
 
 @njit(cache=True, _nrt=False)
-def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, dt_next: float) -> tuple[float, int, float]:
+def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tuple[float, int, float]:
     """Force of the point contact of EDGE pair i (edge of block a on edge of block b); returns
     (elastic energy, active count, friction energy dissipated).
 
@@ -640,7 +640,7 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, dt_next
     fdn = -beta * kna * vn
     bs = 0.0 if slipping else beta * ksa
     if s.dashpots[0] == DASHPOTS_IMPLICIT and beta > 0.0:  # as in _law_range
-        onset = dashpot_onset_share(since, 0.5 * (dt + dt_next)) if closing else 1.0
+        onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
         sc.pair_dashpot_cn[i] = onset * beta * kna
         sc.pair_dashpot_cs[i] = onset * bs
         sc.pair_dashpot_velocity[i, 0] = v0
@@ -658,10 +658,10 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, dt_next
 
 
 @njit(cache=True, _nrt=False)
-def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, dt_next: float) -> None:
+def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
     """Forces and torques on every block at the current poses (joint law of paper §3); ``t`` [s] is
     the time at which body loads (inertial earthquake loading) are sampled, ``dt`` [s] the step
-    just taken, ``dt_next`` [s] the step about to be taken (the velocity update spans their mean)."""
+    just taken."""
     nb = m.block_mass.shape[0]
     sc.force[:] = 0.0
     sc.torque[:] = 0.0
@@ -674,12 +674,12 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, d
         if m.block_free[b]:
             for i in range(3):
                 sc.force[b, i] = m.block_mass[b] * (m.gravity[i] + sc.body_acc[i])
-    elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt, dt_next)
+    elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt)
     if nrel > 0:
         e_fric += _release_pass(m, s, sc, nrel, dt)
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
-            el, ac, ef = _edge_pair(m, s, sc, i, dt, dt_next)
+            el, ac, ef = _edge_pair(m, s, sc, i, dt)
             elastic += el
             active += ac
             e_fric += ef

@@ -357,10 +357,11 @@ KINEMATIC_SHARE = 0.25
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def block_speed(m: ModelArrays, s: State, b: int) -> float:
-    """Upper bound [m/s] of the speed of block b's points: |v| + |omega| r (r its bounding radius)."""
+def block_speed(m: ModelArrays, s: State, b: int, c0: float = 0.0, c1: float = 0.0, c2: float = 0.0) -> float:
+    """Upper bound [m/s] of the speed of block b's points relative to a frame translating at c
+    [m/s]: |v - c| + |omega| r (r its bounding radius)."""
     w = s.omega[b]
-    return (math.sqrt(s.velocity[b, 0] ** 2 + s.velocity[b, 1] ** 2 + s.velocity[b, 2] ** 2)
+    return (math.sqrt((s.velocity[b, 0] - c0) ** 2 + (s.velocity[b, 1] - c1) ** 2 + (s.velocity[b, 2] - c2) ** 2)
             + math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2) * m.block_radius[b])
 
 
@@ -382,9 +383,7 @@ def kinematic_step(m: ModelArrays, s: State) -> float:
     speed = 0.0
     for b in range(nb):
         if s.fell_off[b] < 0.0:
-            w = s.omega[b]
-            speed = max(speed, math.sqrt((s.velocity[b, 0] - c0) ** 2 + (s.velocity[b, 1] - c1) ** 2 + (s.velocity[b, 2] - c2) ** 2)
-                        + math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2) * m.block_radius[b])
+            speed = max(speed, block_speed(m, s, b, c0, c1, c2))
     return KINEMATIC_SHARE * m.contact_tol / speed if speed > 0.0 else np.inf
 
 
@@ -504,7 +503,7 @@ def advance(
         h = 0.5 * (s.dt_prev[0] + dt)
         # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + dt/2]
         # (t itself unless the step was just lowered).
-        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0], dt)
+        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT and has_dashpots(m):
             dashpot_work(m, s, sc, h)
