@@ -28,6 +28,7 @@ def _pair_arrays(count: int) -> dict[str, np.ndarray]:
         "pair_shear": np.zeros((count, 3)),
         "pair_normal_force": np.zeros(count),
         "pair_overlap": np.zeros(count),
+        "pair_set": np.zeros(count),
     }
 
 
@@ -57,6 +58,7 @@ def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
         "prev_pair_normal": np.zeros((count, 3)),
         "prev_pair_normal_force": np.zeros(count),
         "prev_pair_overlap": np.zeros(count),
+        "prev_pair_set": np.zeros(count),
         "prev_pair_key": np.zeros(count, dtype=i64),
         "prev_pair_index": np.zeros(count, dtype=i64),
         "prev_pair_kept": np.zeros(count, dtype=np.bool_),

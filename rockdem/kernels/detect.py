@@ -41,6 +41,7 @@ from .layout import (
     State,
 )
 from .rotation import quat_to_matrix
+from .polygon import segment_closest
 from .sort import sort_indices
 
 EDGE_AXIS_BIAS = 1e-3
@@ -284,6 +285,117 @@ def edge_pairs_changed(m: ModelArrays, s: State, sc: Scratch) -> bool:
     return False
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _world_point(m: ModelArrays, s: State, sc: Scratch, b: int, v: int) -> tuple[float, float, float]:
+    r = sc.rotation[b]
+    x = m.vertex_local[v]
+    return (
+        r[0, 0] * x[0] + r[0, 1] * x[1] + r[0, 2] * x[2] + s.position[b, 0],
+        r[1, 0] * x[0] + r[1, 1] * x[1] + r[1, 2] * x[2] + s.position[b, 1],
+        r[2, 0] * x[0] + r[2, 1] * x[1] + r[2, 2] * x[2] + s.position[b, 2],
+    )
+
+
+EDGE_PARALLEL_SIN = 0.05
+"""Below this sine of the angle between two edges their cross product no longer defines the
+contact normal: the last normal is kept."""
+
+
+@njit(cache=True, _nrt=False)
+def edge_contact(m: ModelArrays, s: State, sc: Scratch, i: int) -> tuple[float, float, float, float, float, float, float]:
+    """Geometry of EDGE pair i (rotations current): (overlap [m], unit normal from b to a, contact
+    point [m], world). The normal is the cross product of the two edges, oriented like the pair's
+    last normal (which it replaces in ``s.pair_normal``); the overlap is measured along it between
+    the closest points of the two edge segments, and the contact point is their midpoint."""
+    a = s.pair_a[i]
+    b = s.pair_b[i]
+    ea = s.pair_edge_a[i]
+    eb = s.pair_edge_b[i]
+    a00, a01, a02 = _world_point(m, s, sc, a, m.edge_vertex[ea, 0])
+    a10, a11, a12 = _world_point(m, s, sc, a, m.edge_vertex[ea, 1])
+    b00, b01, b02 = _world_point(m, s, sc, b, m.edge_vertex[eb, 0])
+    b10, b11, b12 = _world_point(m, s, sc, b, m.edge_vertex[eb, 1])
+    da0, da1, da2 = a10 - a00, a11 - a01, a12 - a02
+    db0, db1, db2 = b10 - b00, b11 - b01, b12 - b02
+    sa, sb = segment_closest(a00, a01, a02, da0, da1, da2, b00, b01, b02, db0, db1, db2)
+    qa0, qa1, qa2 = a00 + sa * da0, a01 + sa * da1, a02 + sa * da2
+    qb0, qb1, qb2 = b00 + sb * db0, b01 + sb * db1, b02 + sb * db2
+    c0, c1, c2 = da1 * db2 - da2 * db1, da2 * db0 - da0 * db2, da0 * db1 - da1 * db0
+    cn = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+    la = math.sqrt(da0 * da0 + da1 * da1 + da2 * da2)
+    lb = math.sqrt(db0 * db0 + db1 * db1 + db2 * db2)
+    m0, m1, m2 = s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2]
+    if cn > EDGE_PARALLEL_SIN * la * lb:
+        n0, n1, n2 = c0 / cn, c1 / cn, c2 / cn
+        if n0 * m0 + n1 * m1 + n2 * m2 < 0.0:
+            n0, n1, n2 = -n0, -n1, -n2
+    else:
+        n0, n1, n2 = m0, m1, m2
+    s.pair_normal[i, 0] = n0
+    s.pair_normal[i, 1] = n1
+    s.pair_normal[i, 2] = n2
+    un = -(n0 * (qa0 - qb0) + n1 * (qa1 - qb1) + n2 * (qa2 - qb2))
+    return un, n0, n1, n2, 0.5 * (qa0 + qb0), 0.5 * (qa1 + qb1), 0.5 * (qa2 + qb2)
+
+
+@njit(cache=True, _nrt=False)
+def _pair_face_energy(m: ModelArrays, s: State, a: int, b: int) -> float:
+    """Elastic energy [J] of the compressed normal springs of the face sub-contacts between blocks
+    a and b, which is taken from them (their normal force is zeroed, so releasing them books only
+    their shear springs). Cost: the two blocks' points."""
+    e = 0.0
+    for side in range(2):
+        blk, oth = (a, b) if side == 0 else (b, a)
+        gb, go = m.block_group[blk], m.block_group[oth]
+        for f in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
+            for p in range(m.face_point_start[f], m.face_point_start[f + 1]):
+                for k in range(SLOTS):
+                    fn = s.slot_normal_force[p, k]
+                    if s.slot_partner[p, k] == oth and fn > 0.0 and s.slot_area[p, k] > 0.0:
+                        e += 0.5 * fn * fn / (m.mat_kn[gb, go] * s.slot_area[p, k])
+                        s.slot_normal_force[p, k] = 0.0
+    return e
+
+
+@njit(cache=True, _nrt=False)
+def hand_over_edge(m: ModelArrays, s: State, sc: Scratch, i: int, k: int) -> None:
+    """Start the spring of EDGE pair i, new at this detection (k: the pair's index at the previous
+    detection, -1 if none), with no more elastic energy than the same two blocks' contact held.
+
+    A contact changes representation under load: three partly covered face sub-contacts of a cube
+    tilting across a wall top (10.3 J) become one edge-edge contact 0.57 mm deep (21.8 J at kn A_e);
+    booking the first as dissipated and starting the second from its geometry created 11.5 J (and
+    23 J in the ledger). So the normal spring energy E of the previous representation (face
+    sub-contacts' or another edge pair's) is handed over: an edge spring that would hold more than E
+    at its overlap u starts unloaded at the *set* u - sqrt(2 E / kn A_e) (``s.pair_set``, which
+    follows the overlap down as the blocks part, so no energy appears later either); one that holds
+    less takes what it holds and the rest is dissipated (booked as friction). A pair new to the two
+    blocks (E = 0) found overlapping starts unloaded at its overlap, which the one-step look-ahead
+    of detection keeps within a fraction of the tracking tolerance."""
+    a = s.pair_a[i]
+    b = s.pair_b[i]
+    ga, gb = m.block_group[a], m.block_group[b]
+    kna = m.mat_kn[ga, gb] * min(m.edge_area[s.pair_edge_a[i]], m.edge_area[s.pair_edge_b[i]])
+    budget = 0.0
+    if k >= 0:
+        if sc.prev_pair_kind[k] == PAIR_EDGE:
+            fn = sc.prev_pair_normal_force[k]
+            area = min(m.edge_area[sc.prev_pair_edge_a[k]], m.edge_area[sc.prev_pair_edge_b[k]])
+            budget = 0.5 * fn * fn / (m.mat_kn[ga, gb] * area)
+            sc.prev_pair_normal_force[k] = 0.0  # handed over, not released
+        else:
+            budget = _pair_face_energy(m, s, a, b)
+    un = edge_contact(m, s, sc, i)[0]
+    held = 0.5 * kna * un * un if un > 0.0 else 0.0
+    if held <= budget:
+        s.pair_set[i] = 0.0
+        s.energy[E_FRICTION] += budget - held
+    else:
+        s.pair_set[i] = un - math.sqrt(2.0 * budget / kna)
+    s.pair_overlap[i] = un - s.pair_set[i]
+    s.pair_normal_force[i] = kna * s.pair_overlap[i] if s.pair_overlap[i] > 0.0 else 0.0
+
+
 @njit(cache=True, _nrt=False)
 def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -> int:
     """Narrow phase of pair (a, b), a < b: adds a pair and its candidate sub-contacts; returns the
@@ -316,7 +428,6 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         s.pair_normal[i, 2] = nz
         s.pair_shear[i, :] = 0.0
         s.pair_normal_force[i] = 0.0
-        s.pair_overlap[i] = 0.0
         k = _previous_pair(m, sc, a, b)  # carry the history of the same edge contact
         if k >= 0 and sc.prev_pair_kind[k] == PAIR_EDGE and sc.prev_pair_edge_a[k] == ea and sc.prev_pair_edge_b[k] == eb:
             sc.prev_pair_kept[k] = True
@@ -324,16 +435,18 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
                 s.pair_shear[i, c] = sc.prev_pair_shear[k, c]
             s.pair_normal_force[i] = sc.prev_pair_normal_force[k]
             s.pair_overlap[i] = sc.prev_pair_overlap[k]
+            s.pair_set[i] = sc.prev_pair_set[k]
+        else:
+            hand_over_edge(m, s, sc, i, k)
         return ncand
     oth = b if ref == a else a
     prev = _previous_pair(m, sc, a, b)
     keep = -1
-    if prev >= 0:
+    if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE is released)
         sc.prev_pair_kept[prev] = True
-        if sc.prev_pair_kind[prev] == PAIR_FACE:
-            for f in (sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]):
-                if m.face_block[f] == oth:
-                    keep = f
+        for f in (sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]):
+            if m.face_block[f] == oth:
+                keep = f
     iface = _incident_face(m, sc, oth, nx, ny, nz, keep, m.contact_tol)
     ar = m.face_area[rface]
     ai = m.face_area[iface]
@@ -504,6 +617,7 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
         sc.prev_pair_edge_b[i] = s.pair_edge_b[i]
         sc.prev_pair_normal_force[i] = s.pair_normal_force[i]
         sc.prev_pair_overlap[i] = s.pair_overlap[i]
+        sc.prev_pair_set[i] = s.pair_set[i]
         for k in range(3):
             sc.prev_pair_shear[i, k] = s.pair_shear[i, k]
             sc.prev_pair_normal[i, k] = s.pair_normal[i, k]

@@ -26,6 +26,7 @@ from .contact import (
     spring_energy,
 )
 from .blend import blend_weight, face_clearance, tracks_target
+from .detect import edge_contact
 from .faces import crossing_lines, cut_cell, face_map_arrays
 from .layout import (
     DASHPOTS_IMPLICIT,
@@ -39,7 +40,6 @@ from .layout import (
     Scratch,
     State,
 )
-from .polygon import segment_closest
 from .series import interpolate
 
 
@@ -527,22 +527,6 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
     return e_fric
 
 
-@njit(cache=True, _nrt=False, inline="always")
-def _world_point(m: ModelArrays, s: State, sc: Scratch, b: int, v: int) -> tuple[float, float, float]:
-    r = sc.rotation[b]
-    x = m.vertex_local[v]
-    return (
-        r[0, 0] * x[0] + r[0, 1] * x[1] + r[0, 2] * x[2] + s.position[b, 0],
-        r[1, 0] * x[0] + r[1, 1] * x[1] + r[1, 2] * x[2] + s.position[b, 1],
-        r[2, 0] * x[0] + r[2, 1] * x[1] + r[2, 2] * x[2] + s.position[b, 2],
-    )
-
-
-EDGE_PARALLEL_SIN = 0.05
-"""Below this sine of the angle between two edges their cross product no longer defines the
-contact normal: the last normal is kept."""
-
-
 @njit(cache=True, _nrt=False)
 def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tuple[float, int, float]:
     """Force of the point contact of EDGE pair i (edge of block a on edge of block b); returns
@@ -559,30 +543,12 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     sc.pair_dashpot_force[i, :] = 0.0
     sc.pair_dashpot_cn[i] = 0.0
     sc.pair_force[i, :] = 0.0
-    a00, a01, a02 = _world_point(m, s, sc, a, m.edge_vertex[ea, 0])
-    a10, a11, a12 = _world_point(m, s, sc, a, m.edge_vertex[ea, 1])
-    b00, b01, b02 = _world_point(m, s, sc, b, m.edge_vertex[eb, 0])
-    b10, b11, b12 = _world_point(m, s, sc, b, m.edge_vertex[eb, 1])
-    da0, da1, da2 = a10 - a00, a11 - a01, a12 - a02
-    db0, db1, db2 = b10 - b00, b11 - b01, b12 - b02
-    sa, sb = segment_closest(a00, a01, a02, da0, da1, da2, b00, b01, b02, db0, db1, db2)
-    qa0, qa1, qa2 = a00 + sa * da0, a01 + sa * da1, a02 + sa * da2
-    qb0, qb1, qb2 = b00 + sb * db0, b01 + sb * db1, b02 + sb * db2
-    c0, c1, c2 = da1 * db2 - da2 * db1, da2 * db0 - da0 * db2, da0 * db1 - da1 * db0
-    cn = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-    la = math.sqrt(da0 * da0 + da1 * da1 + da2 * da2)
-    lb = math.sqrt(db0 * db0 + db1 * db1 + db2 * db2)
-    m0, m1, m2 = s.pair_normal[i, 0], s.pair_normal[i, 1], s.pair_normal[i, 2]
-    if cn > EDGE_PARALLEL_SIN * la * lb:
-        n0, n1, n2 = c0 / cn, c1 / cn, c2 / cn
-        if n0 * m0 + n1 * m1 + n2 * m2 < 0.0:
-            n0, n1, n2 = -n0, -n1, -n2
-    else:
-        n0, n1, n2 = m0, m1, m2
-    s.pair_normal[i, 0] = n0
-    s.pair_normal[i, 1] = n1
-    s.pair_normal[i, 2] = n2
-    un = -(n0 * (qa0 - qb0) + n1 * (qa1 - qb1) + n2 * (qa2 - qb2))
+    un, n0, n1, n2, x0, x1, x2 = edge_contact(m, s, sc, i)
+    st = s.pair_set[i]
+    if st > 0.0:  # unloaded at overlap st (detect.hand_over_edge); follows the overlap down
+        st = min(st, max(un, 0.0))
+        s.pair_set[i] = st
+        un -= st
     ga = m.block_group[a]
     gb = m.block_group[b]
     area = min(m.edge_area[ea], m.edge_area[eb])
@@ -591,7 +557,6 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     us0, us1, us2 = s.pair_shear[i, 0], s.pair_shear[i, 1], s.pair_shear[i, 2]
     un_prev = s.pair_overlap[i]
     s.pair_overlap[i] = un
-    x0, x1, x2 = 0.5 * (qa0 + qb0), 0.5 * (qa1 + qb1), 0.5 * (qa2 + qb2)
     v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, a, b, x0, x1, x2)
     vn = v0 * n0 + v1 * n1 + v2 * n2
     vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2

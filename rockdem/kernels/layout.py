@@ -183,7 +183,9 @@ class State(NamedTuple):
     pair_normal: np.ndarray  # (P, 3) EDGE: contact normal, world, pointing from b to a
     pair_shear: np.ndarray  # (P, 3) [m] EDGE: elastic shear displacement of a relative to b
     pair_normal_force: np.ndarray  # (P,) [N] EDGE: elastic normal force
-    pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass
+    pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass, less pair_set
+    pair_set: np.ndarray  # (P,) [m] EDGE: overlap at which the edge spring is unloaded (>= 0; see
+    # detect.hand_over_edge: a pair formed overlapping starts with no more energy than it replaces)
     moved: np.ndarray  # (nb,) [m] displacement bound since the last detection
     fell_off: np.ndarray  # (nb,) [s] time a free block fell off the edge of the supports, -1: it did not
 
@@ -264,9 +266,10 @@ class Scratch(NamedTuple):
     prev_pair_normal: np.ndarray  # (P, 3)
     prev_pair_normal_force: np.ndarray  # (P,)
     prev_pair_overlap: np.ndarray  # (P,)
+    prev_pair_set: np.ndarray  # (P,)
     prev_pair_key: np.ndarray  # (P,) int64 key a nb + b of each previous pair
     prev_pair_index: np.ndarray  # (P,) int64 the previous pairs in ascending key order
-    prev_pair_kept: np.ndarray  # (P,) bool the previous pair was found again
+    prev_pair_kept: np.ndarray  # (P,) bool the previous pair was found again, as the same contact
     energy_scale: np.ndarray  # (1,) [J] largest energy scale recorded so far (divergence check)
     lost_block: np.ndarray  # (1,) int64 block that diverged or left the extent, -1 none
     sweep_order: np.ndarray  # (nb,) int64 detection: blocks in ascending order of their lowest x
