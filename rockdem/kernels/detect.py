@@ -197,9 +197,13 @@ INCIDENT_KEEP = 0.1
 normal) is within this many tracking tolerances of the deepest vertex of the most opposed face: a
 block rocking on the edge between two of its faces (both reach the same depth) keeps the face
 carrying its sub-contacts (each switch re-represents a loaded contact), while a face landing
-flat takes over as soon as it reaches deeper. (A hysteresis in angle instead, 0.05 in cosine,
-kept the rounded-edge facet of a toppling façade while its 0.8 m face swung 0.12 m into the
-ground.)"""
+flat takes over as soon as it reaches deeper, or as soon as all its corners come within the
+tolerance of its deepest one (it is about to land flat: its far corners must be tracked before
+they press). Without the second rule a brick pivoting down onto its bed face kept its end face
+(they share the pivot edge) until the bed face's far edge was 0.29 mm into the ground, and its
+sub-contacts switched on there with 15 J at once. (A hysteresis in angle instead, 0.05 in
+cosine, kept the rounded-edge facet of a toppling façade while its 0.8 m face swung 0.12 m into
+the ground.)"""
 
 
 @njit(cache=True, _nrt=False)
@@ -229,13 +233,17 @@ def _facing(r: np.ndarray, fn: np.ndarray, nx: float, ny: float, nz: float) -> f
 
 
 @njit(cache=True, _nrt=False)
-def _face_depth(m: ModelArrays, sc: Scratch, f: int, nx: float, ny: float, nz: float) -> float:
-    """Lowest position of face f's corners along the world direction n [m] (world vertices current)."""
+def _face_span(m: ModelArrays, sc: Scratch, f: int, nx: float, ny: float, nz: float) -> tuple[float, float]:
+    """Lowest and highest position of face f's corners along the world direction n [m] (world
+    vertices current)."""
     low = np.inf
+    high = -np.inf
     for c in range(m.face_corner_start[f], m.face_corner_start[f + 1]):
         v = m.face_corner[c]
-        low = min(low, nx * sc.world_vertex[v, 0] + ny * sc.world_vertex[v, 1] + nz * sc.world_vertex[v, 2])
-    return low
+        h = nx * sc.world_vertex[v, 0] + ny * sc.world_vertex[v, 1] + nz * sc.world_vertex[v, 2]
+        low = min(low, h)
+        high = max(high, h)
+    return low, high
 
 
 @njit(cache=True, _nrt=False)
@@ -243,7 +251,8 @@ def _incident_face(
     m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, previous: int, tol: float
 ) -> int:
     """Face of ``blk`` most opposed to the world direction n, or ``previous`` (a face of blk, or
-    -1) while it reaches as deep along -n as that face, within INCIDENT_KEEP tolerances ``tol``."""
+    -1) while it reaches as deep along -n as that face, within INCIDENT_KEEP tolerances ``tol``,
+    and that face's corners are not all within ``tol`` of its deepest one."""
     r = sc.rotation[blk]
     lowest = np.inf
     out = -1
@@ -252,7 +261,8 @@ def _incident_face(
         if c < lowest:
             lowest, out = c, g
     if previous >= 0 and previous != out:
-        if _face_depth(m, sc, previous, nx, ny, nz) <= _face_depth(m, sc, out, nx, ny, nz) + INCIDENT_KEEP * tol:
+        low, high = _face_span(m, sc, out, nx, ny, nz)
+        if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and high - low >= tol:
             return previous
     return out
 
