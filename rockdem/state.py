@@ -102,6 +102,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         slot_normal_force=np.zeros((n_pts, SLOTS)),
         slot_area=np.zeros((n_pts, SLOTS)),
         slot_overlap=np.zeros((n_pts, SLOTS)),
+        slot_set=np.zeros((n_pts, SLOTS)),
         slot_bonded=np.zeros((n_pts, SLOTS), dtype=np.bool_),
         point_failed=np.full(n_pts, FAILED_NONE, dtype=np.int64),
         energy=np.zeros(ENERGY_COUNT),

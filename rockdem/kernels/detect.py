@@ -532,6 +532,7 @@ def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
     s.slot_normal_force[p, k] = 0.0
     s.slot_area[p, k] = 0.0
     s.slot_overlap[p, k] = 0.0
+    s.slot_set[p, k] = 0.0
 
 
 @njit(cache=True, _nrt=False)
@@ -577,6 +578,7 @@ def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
                 s.slot_normal_force[p, k] = 0.0
                 s.slot_area[p, k] = 0.0
                 s.slot_overlap[p, k] = 0.0
+                s.slot_set[p, k] = 0.0
                 sc.seen[SLOTS * p + k] = passid
                 sc.cand_slot[c] = k
                 break

@@ -67,6 +67,30 @@ def _relative_velocity_arrays(
 
 
 @njit(cache=True, _nrt=False, inline="always")
+def area_change(
+    slot_set: np.ndarray, p: int, j: int, un: float, un_prev: float, area: float, prev_area: float, kn: float
+) -> tuple[float, float]:
+    """Overlap [m] of an unbonded sub-contact whose effective area went from ``prev_area`` to
+    ``area`` [m^2] in the last step at overlap ``un`` (measured from its set ``slot_set[p, j]``
+    [m]), and the energy [J] dissipated. Compressed at both steps, a growing area keeps the spring
+    energy: the set rises so that kn A u^2 / 2 is that of the last area; a shrinking one loses
+    kn (A_prev - A) u^2 / 2 (returned). The set follows the overlap down, to 0 once it opens."""
+    st = slot_set[p, j]
+    e = 0.0
+    if un > 0.0 and un_prev > 0.0 and prev_area > 0.0 and area > 0.0:
+        if area > prev_area:
+            kept = un * math.sqrt(prev_area / area)
+            st += un - kept
+            un = kept
+        elif area < prev_area:
+            e = 0.5 * kn * (prev_area - area) * un * un
+    elif st > 0.0 and un < 0.0:
+        st = max(st + un, 0.0)  # opened: the set comes down to the geometric overlap st + un, or 0
+    slot_set[p, j] = st
+    return un, e
+
+
+@njit(cache=True, _nrt=False, inline="always")
 def _store(force: np.ndarray, point: np.ndarray, k: int, f0: float, f1: float, f2: float, x0: float, x1: float, x2: float) -> None:
     """Contact k's force (on its first block) and point of application."""
     force[k, 0] = f0
@@ -251,6 +275,7 @@ def _law_range(
                 unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
                 unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
+            shift -= s.slot_set[p, j]  # a partly covered cell's set (below): its overlap is measured from it
         sc.track_point_u[k] = yu
         sc.track_point_w[k] = yw
         sc.track_depth_shift[k] = shift
@@ -278,10 +303,18 @@ def _law_range(
         sc.track_area[k] = area
         un = -(fm.h0 + fm.hu * yu + fm.hw * yw) + shift
         un_prev = s.slot_overlap[p, j]
-        s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
         bonded = s.slot_bonded[p, j]
         prev_area = s.slot_area[p, j]
+        if mask > 0 and not bonded and not blending:
+            # A partly covered cell whose area changes under load (its cover slides): the spring
+            # kn A u^2 / 2 would gain or lose kn u^2 dA / 2 without work. It keeps its energy as
+            # the area grows (its overlap is measured from a set, s.slot_set, which follows the
+            # overlap down as it opens) and what it holds less as the area shrinks is dissipated.
+            un, e_set = area_change(s.slot_set, p, j, un, un_prev, area, prev_area, kn)
+            sc.track_depth_shift[k] = shift + (un - (-(fm.h0 + fm.hu * yu + fm.hw * yw) + shift))
+            e_fric += e_set
+        s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         s.slot_area[p, j] = area
         # Contact point: midway between the owner-plane point and the target plane.
         x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0

@@ -161,7 +161,9 @@ class State(NamedTuple):
     slot_shear: np.ndarray  # (np, SLOTS, 3) [m] elastic shear displacement, world (owner rel. target)
     slot_normal_force: np.ndarray  # (np, SLOTS) [N] elastic normal force (compression > 0)
     slot_area: np.ndarray  # (np, SLOTS) [m^2] effective area: the cell area the partner covers
-    slot_overlap: np.ndarray  # (np, SLOTS) [m] normal overlap at the last force pass (> 0 compression)
+    slot_overlap: np.ndarray  # (np, SLOTS) [m] normal overlap at the last force pass (> 0 compression), less slot_set
+    slot_set: np.ndarray  # (np, SLOTS) [m] overlap at which a partly covered unbonded cell's spring is
+    # unloaded (>= 0; forces.area_change: its area grew under load)
     slot_bonded: np.ndarray  # (np, SLOTS) bool
     point_failed: np.ndarray  # (np,) int64 FAILED_*
     energy: np.ndarray  # (ENERGY_COUNT,) [J] accumulated dissipation and work
