@@ -125,7 +125,7 @@ def test_loaded_contact_changing_representation_keeps_its_energy():
     out, ds = scenarios.evaluate(sc)
     assert not out.diverged
     z = ds.block_position.values[:, sc.model.block_id("cube"), 2]
-    assert z[-1] < z[0] - 0.2  # it tipped off the wall top
+    assert z[-1] < z[0] - 0.1  # it tipped over the wall's edge
     assert out.balance_error < 0.005, f"energy balance off by {100 * out.balance_error:.3g} %"
     assert out.energy_created <= 0.001 * out.energy_scale
     assert out.overlap_relative < 0.02
