@@ -40,8 +40,8 @@ from .layout import (
     Scratch,
     State,
 )
-from .rotation import quat_to_matrix
 from .polygon import segment_closest
+from .rotation import quat_to_matrix
 from .sort import sort_indices
 
 EDGE_AXIS_BIAS = 1e-3

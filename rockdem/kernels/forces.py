@@ -259,6 +259,7 @@ def _law_range(
     ks = m.mat_ks[go, gt]
     beta = m.mat_beta[go, gt]
     n0, n1, n2 = fm.nx, fm.ny, fm.nz
+    cut = mask != 0 and mask != -2  # cells are clipped by the target's edge lines (cut_cell)
     for k in range(k0, k1):
         code = s.track[k]
         p = code // SLOTS
@@ -306,13 +307,14 @@ def _law_range(
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
         bonded = s.slot_bonded[p, j]
         prev_area = s.slot_area[p, j]
-        if mask > 0 and not bonded and not blending:
+        if cut and not bonded and not blending:
             # A partly covered cell whose area changes under load (its cover slides): the spring
             # kn A u^2 / 2 would gain or lose kn u^2 dA / 2 without work. It keeps its energy as
             # the area grows (its overlap is measured from a set, s.slot_set, which follows the
             # overlap down as it opens) and what it holds less as the area shrinks is dissipated.
+            un_cover = un
             un, e_set = area_change(s.slot_set, p, j, un, un_prev, area, prev_area, kn)
-            sc.track_depth_shift[k] = shift + (un - (-(fm.h0 + fm.hu * yu + fm.hw * yw) + shift))
+            sc.track_depth_shift[k] = shift + (un - un_cover)
             e_fric += e_set
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         s.slot_area[p, j] = area
