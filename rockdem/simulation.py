@@ -308,6 +308,7 @@ def run_model(
         "dashpot_sweeps": int(state.dashpot_sweeps[0]),
         "dashpot_unconverged_steps": int(state.dashpot_unconverged[0]),
         "steps": int(state.step[0]),
+        "sub_contact_updates": int(state.slot_updates[0]),
         "runtime_s": runtime,
         "kernel_s": kernel,
         "duration": duration,

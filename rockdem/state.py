@@ -92,6 +92,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         dashpot_sweeps=np.zeros(1, dtype=np.int64),
         dashpot_unconverged=np.zeros(1, dtype=np.int64),
         step=np.zeros(1, dtype=np.int64),
+        slot_updates=np.zeros(1, dtype=np.int64),
         position=model.position0.copy(),
         quaternion=model.quaternion0.copy(),
         velocity=model.velocity0.copy(),

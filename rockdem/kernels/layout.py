@@ -152,6 +152,7 @@ class State(NamedTuple):
     dashpot_sweeps: np.ndarray  # (1,) int64 Jacobi sweeps of the implicit dashpots of coupled free blocks so far
     dashpot_unconverged: np.ndarray  # (1,) int64 steps whose sweeps stopped at DASHPOT_MAX_SWEEPS
     step: np.ndarray  # (1,) int64 steps taken
+    slot_updates: np.ndarray  # (1,) int64 tracked sub-contacts summed over the steps taken (work done)
     position: np.ndarray  # (nb, 3) [m] centroid
     quaternion: np.ndarray  # (nb, 4) body -> world
     velocity: np.ndarray  # (nb, 3) [m/s] at the last half step

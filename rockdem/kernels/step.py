@@ -511,6 +511,7 @@ def advance(
         s.dt_prev[0] = dt
         s.time[0] = t + dt
         s.step[0] += 1
+        s.slot_updates[0] += s.track_count[0]
         if end > frame:
             frame = end
             status = check_frame(m, s, sc, rec, end - 1)
