@@ -47,9 +47,10 @@ from .timestep import TimestepInfo
 __all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 """Version of the checkpoint file layout; a file of another version is refused. (2: the model
-hash covers ``ModelArrays.face_corner_uw``, so a version-1 file's hash would not match.)"""
+hash covers ``ModelArrays.face_corner_uw``, so a version-1 file's hash would not match. 3: the
+state holds ``slot_stiffening`` and ``slot_updates``, the model ``point_corner``.)"""
 
 LOADING_FIELDS = frozenset(
     {"block_motion", "motion_start", "motion_time", "motion_velocity", "ground_motion", "body_time",

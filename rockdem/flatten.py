@@ -62,7 +62,7 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
     edge_vertex, edge_area, dirs = [], [], []
     fblock, fnorm, foff, farea, forig, fu, fw = [], [], [], [], [], [], []
     cstart, corner, corner_uw, lstart, lines = [0], [], [], [0], []
-    pstart, ploc, parea, pblock, pface, pnode = [0], [], [], [], [], []
+    pstart, ploc, parea, pblock, pface, pnode, pcorner = [0], [], [], [], [], [], []
     cellstart, cellv = [0], []
     for b, blk in enumerate(blocks):
         rot, cen = blk.rotation, blk.centroid
@@ -99,6 +99,12 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
             pblock.append(np.full(len(g.areas), b))
             pface.append(np.full(len(g.areas), fid))
             pnode.append(g.nodes)
+            # The point that sits on a corner of its face (a block vertex): a vertex-face contact there
+            # is stiffened (kernels.forces, docs/contacts.md).
+            gap = np.linalg.norm(g.nodes[:, None, :] - q[None, :, :], axis=2)  # (points, corners) [m]
+            near = np.argmin(gap, axis=1)
+            on = gap[np.arange(len(near)), near] <= 1e-9 * max(float(np.ptp(q)), 1e-300)
+            pcorner.append(np.where(on, cstart[-2] + near, -1))
             for cell in g.cells:
                 cellv.extend(cell)
                 cellstart.append(len(cellv))
@@ -141,6 +147,7 @@ def flatten_geometry(blocks: Sequence[BlockFrame]) -> dict[str, NDArray]:
         "point_block": np.concatenate(pblock).astype(i64),
         "point_face": np.concatenate(pface).astype(i64),
         "point_node": np.concatenate(pnode),
+        "point_corner": np.concatenate(pcorner).astype(i64),
         "point_cell_start": np.array(cellstart, dtype=i64),
         "cell_vertex": np.array(cellv).reshape(-1, 2),
     }

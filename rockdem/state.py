@@ -29,6 +29,7 @@ def _pair_arrays(count: int) -> dict[str, np.ndarray]:
         "pair_normal_force": np.zeros(count),
         "pair_overlap": np.zeros(count),
         "pair_set": np.zeros(count),
+        "pair_from_edge": np.zeros(count, dtype=np.bool_),
     }
 
 
@@ -105,6 +106,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         slot_overlap=np.zeros((n_pts, SLOTS)),
         slot_set=np.zeros((n_pts, SLOTS)),
         slot_bonded=np.zeros((n_pts, SLOTS), dtype=np.bool_),
+        slot_stiffening=np.ones((n_pts, SLOTS)),
         point_failed=np.full(n_pts, FAILED_NONE, dtype=np.int64),
         energy=np.zeros(ENERGY_COUNT),
         track=np.zeros(SLOTS * n_pts, dtype=np.int64),

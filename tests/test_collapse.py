@@ -61,6 +61,79 @@ def test_tilted_drop_conserves_energy():
     assert abs(err) < 0.01
 
 
+def _landing(turn, points, speed=3.0):
+    """A 0.3 x 0.2 x 0.1 m box (2000 kg/m^3) turned by the rotation ``turn``, its lowest vertex (or
+    edge) 0.1 mm above a rigid ground, falling at ``speed`` [m/s], frictionless, undamped,
+    kn = 1 GPa/m. Returns (largest overlap [m], effective mass [kg] of the lowest point (the
+    middle of the lowest edge where two vertices tie) along the vertical, area [m^2] of the face
+    most opposed to the ground and of its corner cells)."""
+    from rockdem.diagnostics import max_interpenetration
+    from rockdem.geometry import box
+    from rockdem.materials import JointMaterial
+    from rockdem.model import ModelBuilder
+
+    dims = np.array([0.3, 0.2, 0.1])
+    poly = box(*dims, name="box").transformed(turn, np.zeros(3))  # centroid at the origin
+    z = poly.vertices[:, 2]
+    low = poly.vertices[z < z.min() + 1e-9].mean(axis=0)
+    b = ModelBuilder(points=points)
+    b.default_material = JointMaterial(kn=1e9, friction_angle=0.0)
+    b.add_box(2.0, 2.0, 0.2, base_center=(0, 0, -0.2), driven=True, name="ground")
+    b.add_block(poly.transformed(np.eye(3), [0.0, 0.0, 1e-4 - low[2]]), density=2000.0, name="box", velocity=(0.0, 0.0, -speed))
+    ds = simulate(b.finalize(), 0.0015, record_interval=1e-5, progress=False)
+    mass = 2000.0 * dims.prod()
+    inertia = turn @ np.diag(mass / 12.0 * (dims @ dims - dims**2)) @ turn.T  # world, about the centroid
+    arm = np.cross(low, [0.0, 0.0, 1.0])
+    m_eff = 1.0 / (1.0 / mass + arm @ np.linalg.solve(inertia, arm))
+    normals = turn @ np.hstack([np.eye(3), -np.eye(3)])  # (3, 6) outward normals of the turned box
+    axis = int(np.argmin(normals[2])) % 3  # the face most opposed to the ground's normal
+    area = float(np.prod(np.delete(dims, axis)))
+    return max_interpenetration(ds).depth, m_eff, area, area / (4 * (points[0] - 1) * (points[1] - 1))
+
+
+@pytest.mark.parametrize("points", [(2, 2), (3, 3), (2, 5)])
+def test_a_corner_lands_as_stiff_as_its_face_landing_flat(points):
+    # A vertex-face contact (docs/contacts.md, section 2): the corner that lands alone is held by
+    # kn x the incident face's area, not by its own cell (1/4 to 1/16 of that here): its largest
+    # overlap is v sqrt(m_eff / (kn A_face)) whatever the interface points.
+    from rockdem.kernels.rotation import axis_angle_matrix
+
+    turn = axis_angle_matrix(np.array([1.0, 0, 0]), np.radians(20)) @ axis_angle_matrix(np.array([0, 1.0, 0]), np.radians(30))
+    depth, m_eff, area, cell = _landing(turn, points)
+    assert depth == pytest.approx(3.0 * np.sqrt(m_eff / (1e9 * area)), rel=0.03)
+    assert depth < 0.5 * 3.0 * np.sqrt(m_eff / (1e9 * cell))  # what the corner's own cell would let it sink
+
+
+def test_the_step_resolves_a_corner_landing_whatever_the_interface_points():
+    # The timestep bound counts a corner about to land with the stiffness it will have (its face's),
+    # so the step at the start does not depend on the grid (its own cell is 1/4 to 1/16 of the face).
+    from rockdem.geometry import box
+    from rockdem.kernels.rotation import axis_angle_matrix
+    from rockdem.materials import JointMaterial
+    from rockdem.model import ModelBuilder
+
+    turn = axis_angle_matrix(np.array([1.0, 0, 0]), np.radians(20)) @ axis_angle_matrix(np.array([0, 1.0, 0]), np.radians(30))
+    poly = box(0.3, 0.2, 0.1, name="box").transformed(turn, np.zeros(3))
+    poly = poly.transformed(np.eye(3), [0.0, 0.0, 1e-4 - poly.vertices[:, 2].min()])
+    steps = []
+    for points in [(2, 2), (3, 3), (2, 5)]:
+        b = ModelBuilder(points=points)
+        b.default_material = JointMaterial(kn=1e9, friction_angle=30.0)
+        b.add_box(2.0, 2.0, 0.2, base_center=(0, 0, -0.2), driven=True, name="ground")
+        b.add_block(poly, density=2000.0, name="box")
+        steps.append(stable_timestep(b.finalize()).dt)
+    assert steps[1] == pytest.approx(steps[0], rel=1e-9) and steps[2] == pytest.approx(steps[0], rel=1e-9)
+
+
+def test_an_edge_landing_keeps_its_corner_springs():
+    # An edge landing flat (the paper's rocking impact on the two corner springs of 2 x 2 points) is
+    # not stiffened: its overlap is v sqrt(m_eff / (2 kn A_cell)).
+    from rockdem.kernels.rotation import axis_angle_matrix
+
+    depth, m_eff, area, cell = _landing(axis_angle_matrix(np.array([1.0, 0, 0]), np.radians(25)), (2, 2))
+    assert depth == pytest.approx(3.0 * np.sqrt(m_eff / (1e9 * 2 * cell)), rel=0.03)
+
+
 SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge", "tip_over_edge", "corner_near_edge", "facade_topple"]
 
 

@@ -7,7 +7,7 @@ d)_j^2 / I_bj)) (principal body frame; 0 for a driven block), the row sum of blo
 sum u_b (u_b + u_o), an upper bound of omega^2 over the whole system. Then, per block,
 dt_b = (2 / omega_b) (sqrt(1 + xi^2) - xi), xi = beta omega_b / 2 (Belytschko), beta the largest
 of its joints. A sub-contact counts with its full cell area (the most its partner can cover) at its
-point, an edge contact with its area at the middle of its edge; tracked contacts include every
+point (a landing corner with its stiffened area, :func:`rockdem.kernels.forces.corner_stiffening`), an edge contact with its area at the middle of its edge; tracked contacts include every
 one within the tracking tolerance, so the bound holds until the next detection, when it is
 computed again.
 """
@@ -20,22 +20,10 @@ import numpy as np
 from numba import njit
 
 from .contact import sp_critical_factor
-from .layout import PAIR_EDGE, SLOTS, ModelArrays, Scratch, State
-
-
-@njit(cache=True, _nrt=False, inline="always")
-def _flex(rot: np.ndarray, inv_mass: float, inv_inertia: np.ndarray, r0: float, r1: float, r2: float, d0: float, d1: float, d2: float) -> float:
-    """1/m + sum_j (r x d)_j^2 / I_j in a block's principal frame (0 for driven blocks: inv_mass 0)."""
-    if inv_mass == 0.0:
-        return 0.0
-    c0 = r1 * d2 - r2 * d1
-    c1 = r2 * d0 - r0 * d2
-    c2 = r0 * d1 - r1 * d0
-    out = inv_mass
-    for j in range(3):
-        cj = rot[0, j] * c0 + rot[1, j] * c1 + rot[2, j] * c2
-        out += cj * cj * inv_inertia[j]
-    return out
+from .faces import face_map
+from .forces import flexibility as _flex
+from .forces import landing_corner
+from .layout import DASHPOTS_IMPLICIT, PAIR_EDGE, SLOTS, ModelArrays, Scratch, State
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -113,6 +101,9 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch, sp_reduction: bool) -> 
         b = m.face_block[s.pair_target_face[i]]
         split = s.pair_track_split[i]
         side_a0 = side_b0 = side_a1 = side_b1 = 0.0
+        # Each side's face map, for the corners that may land before the next detection.
+        fm0 = face_map(m, s, sc, s.pair_owner_face[i], s.pair_target_face[i])
+        fm1 = face_map(m, s, sc, s.pair_target_face[i], s.pair_owner_face[i])
         for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
             # The owner's points press on the target face, the target's on the owner face.
             ft = s.pair_target_face[i] if k < split else s.pair_owner_face[i]
@@ -129,7 +120,15 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch, sp_reduction: bool) -> 
             x0 = ro[0, 0] * pl[0] + ro[0, 1] * pl[1] + ro[0, 2] * pl[2] + s.position[o, 0]
             x1 = ro[1, 0] * pl[0] + ro[1, 1] * pl[1] + ro[1, 2] * pl[2] + s.position[o, 1]
             x2 = ro[2, 0] * pl[0] + ro[2, 1] * pl[1] + ro[2, 2] * pl[2] + s.position[o, 2]
-            r_o, r_t = _contact_rows(m, s, sc, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p])
+            # A landed corner counts with its stiffening, an open one with what it would get if it
+            # landed now (kernels.forces.corner_stiffening), so that the step comes down to resolve
+            # it; its stiffening never exceeds what the step at its landing resolves.
+            j = s.track[k] - SLOTS * p
+            stiff = s.slot_stiffening[p, j]
+            if m.point_corner[p] >= 0 and not s.slot_bonded[p, j] and (s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0):
+                fm = fm0 if k < split else fm1
+                stiff = landing_corner(m, p, m.point_face[p], ft, fm.h0, fm.hu, fm.hw) if s.dashpots[0] == DASHPOTS_IMPLICIT else 1.0
+            r_o, r_t = _contact_rows(m, s, sc, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p] * stiff)
             if k < split:
                 side_a0 += r_o
                 side_b0 += r_t

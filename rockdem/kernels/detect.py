@@ -428,6 +428,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
     s.pair_track_start[i] = ncand
     s.pair_track_split[i] = ncand
     s.pair_track_stop[i] = ncand
+    s.pair_from_edge[i] = False
     if kind == PAIR_EDGE:
         ea = _supporting_edge(m, sc, a, da, nx, ny, nz, True)
         eb = _supporting_edge(m, sc, b, db, nx, ny, nz, False)
@@ -452,6 +453,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
     oth = b if ref == a else a
     prev = _previous_pair(m, sc, a, b)
     keep = -1
+    s.pair_from_edge[i] = prev >= 0 and sc.prev_pair_kind[prev] == PAIR_EDGE and sc.prev_pair_normal_force[prev] > 0.0
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE is released)
         sc.prev_pair_kept[prev] = True
         for f in (sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]):
@@ -533,6 +535,7 @@ def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
     s.slot_area[p, k] = 0.0
     s.slot_overlap[p, k] = 0.0
     s.slot_set[p, k] = 0.0
+    s.slot_stiffening[p, k] = 1.0
 
 
 @njit(cache=True, _nrt=False)
@@ -579,6 +582,7 @@ def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
                 s.slot_area[p, k] = 0.0
                 s.slot_overlap[p, k] = 0.0
                 s.slot_set[p, k] = 0.0
+                s.slot_stiffening[p, k] = 1.0
                 sc.seen[SLOTS * p + k] = passid
                 sc.cand_slot[c] = k
                 break

@@ -110,6 +110,7 @@ class ModelArrays(NamedTuple):
     point_block: np.ndarray  # (np,) int64
     point_face: np.ndarray  # (np,) int64
     point_node: np.ndarray  # (np, 2) [m] the point in face coordinates
+    point_corner: np.ndarray  # (np,) int64 index into face_corner of the block vertex the point sits on, -1 none
     point_cell_start: np.ndarray  # (np+1,)
     cell_vertex: np.ndarray  # (ncv, 2) [m] tributary cell polygons in face coordinates (CCW)
     mat_kn: np.ndarray  # (ng, ng) [Pa/m]
@@ -166,6 +167,7 @@ class State(NamedTuple):
     slot_set: np.ndarray  # (np, SLOTS) [m] overlap at which a partly covered unbonded cell's spring is
     # unloaded (>= 0; forces.area_change: its area grew under load)
     slot_bonded: np.ndarray  # (np, SLOTS) bool
+    slot_stiffening: np.ndarray  # (np, SLOTS) [-] area factor of a corner that landed alone (vertex-face contact), 1 otherwise
     point_failed: np.ndarray  # (np,) int64 FAILED_*
     energy: np.ndarray  # (ENERGY_COUNT,) [J] accumulated dissipation and work
     track: np.ndarray  # (SLOTS np,) int64 contact codes 2 p + k, grouped by pair
@@ -187,6 +189,8 @@ class State(NamedTuple):
     pair_shear: np.ndarray  # (P, 3) [m] EDGE: elastic shear displacement of a relative to b
     pair_normal_force: np.ndarray  # (P,) [N] EDGE: elastic normal force
     pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass, less pair_set
+    pair_from_edge: np.ndarray  # (P,) bool FACE: formed at this detection from a pressed EDGE pair of the
+    # same blocks (its sub-contacts continue that contact: none is a landing corner)
     pair_set: np.ndarray  # (P,) [m] EDGE: overlap at which the edge spring is unloaded (>= 0; see
     # detect.hand_over_edge: a pair formed overlapping starts with no more energy than it replaces)
     moved: np.ndarray  # (nb,) [m] displacement bound since the last detection
