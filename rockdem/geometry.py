@@ -235,21 +235,44 @@ def _clip(poly: NDArray[np.float64], clipper: NDArray[np.float64]) -> NDArray[np
     for i in range(n):
         if len(out) == 0:
             break
-        a, b = clipper[i], clipper[(i + 1) % n]
-        e = b - a
-        inp = out
-        out_list = []
-        side = e[0] * (inp[:, 1] - a[1]) - e[1] * (inp[:, 0] - a[0])
-        m = len(inp)
-        for j in range(m):
-            cur, nxt = inp[j], inp[(j + 1) % m]
-            sc, sn = side[j], side[(j + 1) % m]
-            if sc >= 0:
-                out_list.append(cur)
-            if (sc >= 0) != (sn >= 0):
-                t = sc / (sc - sn)
-                out_list.append(cur + t * (nxt - cur))
-        out = np.array(out_list) if out_list else np.zeros((0, 2))
+        out = _clip_line(out, clipper[i], clipper[(i + 1) % n] - clipper[i])
+    return out
+
+
+def _clip_line(poly: NDArray[np.float64], a: NDArray[np.float64], e: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The part of 2D polygon ``poly`` on the left of the line through ``a`` along ``e`` (or on it)."""
+    out_list = []
+    side = e[0] * (poly[:, 1] - a[1]) - e[1] * (poly[:, 0] - a[0])
+    m = len(poly)
+    for j in range(m):
+        cur, nxt = poly[j], poly[(j + 1) % m]
+        sc, sn = side[j], side[(j + 1) % m]
+        if sc >= 0:
+            out_list.append(cur)
+        if (sc >= 0) != (sn >= 0):
+            t = sc / (sc - sn)
+            out_list.append(cur + t * (nxt - cur))
+    return np.array(out_list) if out_list else np.zeros((0, 2))
+
+
+def _split_at_corners(
+    node: NDArray[np.float64], cell: NDArray[np.float64], corners: list[NDArray[np.float64]], tol: float
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """(node, cell) pairs that give each face corner in ``cell`` a point of its own: the cell is
+    split among its node and those corners by their Voronoi regions (each part convex, the parts
+    sum to the cell). Without corners, the cell as it is."""
+    if not corners:
+        return [(node, cell)]
+    gens = [node, *corners]
+    out = []
+    for i, g in enumerate(gens):
+        part = cell
+        for j, h in enumerate(gens):
+            if j != i and len(part):
+                d = h - g
+                part = _clip_line(part, 0.5 * (g + h), np.array([-d[1], d[0]]))
+        if len(part) >= 3 and abs(_polygon_area(part)) > tol * tol:
+            out.append((g if i > 0 or _inside_2d(g, part, tol) else _polygon_centroid(part), part))
     return out
 
 
@@ -304,7 +327,10 @@ def face_grid(poly: Polyhedron, face: int, n_across: int, n_along: int) -> FaceG
     corners of a rectangular face (3DEC's minimal sub-contacts, the paper's "2 contact points").
     Each node's tributary cell (half cells at the ends, the trapezoidal rule) is clipped to the
     face polygon; its clipped area is the point's area, so the areas sum exactly to the face area.
-    A node outside a non-rectangular face is moved to its clipped cell's centroid. The cells are
+    A node outside a non-rectangular face is moved to its clipped cell's centroid, and (with at
+    least 2 x 2 nodes) every corner of the face that is not a node gets a point of its own, with
+    the part of its cell nearer to it than to the cell's node (a block landing on that corner is
+    held there; a rectangle's corners are nodes already). The cells are
     what the contact law clips against a partner face (see ``docs/contacts.md``): the force of a
     point is carried by the part of its cell that the partner covers.
     """
@@ -337,6 +363,7 @@ def face_grid(poly: Polyhedron, face: int, n_across: int, n_along: int) -> FaceG
     gu = _nodes(su.min(), su.max(), n_across)
     gw = _nodes(sw.min(), sw.max(), n_along)
     size = max(np.ptp(su), np.ptp(sw))
+    grid = []  # (node, clipped cell) of each grid cell with an area
     for (ucen, ulo, uhi) in gu:
         for (wcen, wlo, whi) in gw:
             cell = np.array([[ulo, wlo], [uhi, wlo], [uhi, whi], [ulo, whi]])
@@ -349,9 +376,21 @@ def face_grid(poly: Polyhedron, face: int, n_across: int, n_along: int) -> FaceG
             node = np.array([ucen, wcen])
             if not _inside_2d(node, q2, 1e-9 * size):
                 node = _polygon_centroid(clipped)
-            nodes.append(node)
-            areas.append(area)
-            cells.append(_drop_duplicates(clipped, 1e-12 * size))
+            grid.append((node, _drop_duplicates(clipped, 1e-12 * size)))
+    # With nodes on the face's edges (2 or more each way), every face corner gets a point (a corner
+    # that lands alone must be held there): a corner that is no node takes the part of the cell it
+    # lies in that is nearer to it than to the cell's node. (One node across or along is a line
+    # of points the user chose.)
+    free = [c for c in range(len(q2)) if all(np.max(np.abs(q2[c] - node)) > 1e-9 * size for node, _ in grid)]
+    if n_across < 2 or n_along < 2:
+        free = []
+    for node, clipped in grid:
+        mine = [c for c in free if _inside_2d(q2[c], clipped, 1e-9 * size)]
+        free = [c for c in free if c not in mine]
+        for pt, part in _split_at_corners(node, clipped, [q2[c] for c in mine], np.sqrt(_REL_TOL) * size):
+            nodes.append(pt)
+            areas.append(abs(_polygon_area(part)))
+            cells.append(part if part is clipped else _drop_duplicates(part, 1e-12 * size))
     nodes_a = np.array(nodes)
     points = c + nodes_a[:, :1] * u3 + nodes_a[:, 1:] * w3
     return FaceGrid(c, u3, w3, points, nodes_a, np.array(areas), tuple(cells))

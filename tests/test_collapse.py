@@ -134,6 +134,36 @@ def test_an_edge_landing_keeps_its_corner_springs():
     assert depth == pytest.approx(3.0 * np.sqrt(m_eff / (1e9 * 2 * cell)), rel=0.03)
 
 
+@pytest.mark.parametrize("shape", ["wedge", "hexagonal prism"])
+def test_a_block_landing_on_the_corner_of_a_non_rectangular_face_is_held_there(shape):
+    # A corner of a triangular or hexagonal face is no node of the face's 2 x 2 grid; it has a point
+    # of its own, so a block landing on it is held at once. Before, the corner carried no point:
+    # these two landed 11.6 % and 15.1 % of their thickness deep (random landings: up to 35 %).
+    from rockdem.diagnostics import max_interpenetration
+    from rockdem.geometry import convex_hull
+    from rockdem.kernels.rotation import axis_angle_matrix
+    from rockdem.materials import JointMaterial
+    from rockdem.model import ModelBuilder
+
+    if shape == "wedge":
+        section = np.array([[0.0, 0.0], [0.17, 0.0], [0.06, 0.11]])
+        verts = [[x, y, z] for x, z in section for y in (0.0, 0.3)]
+    else:
+        verts = [[0.1 * np.cos(a), 0.1 * np.sin(a), z] for a in np.arange(6) * np.pi / 3 + 0.3 for z in (0.0, 0.2)]
+    poly = convex_hull(verts, name=shape)
+    axis, angle = ([1.4, 0.7, 0.8], 1.35) if shape == "wedge" else ([-0.7, 0.2, -0.8], 1.14)  # (without the corner points: 11.6 %, 15.1 %)
+    turn = axis_angle_matrix(np.array(axis) / np.linalg.norm(axis), angle)
+    poly = poly.transformed(turn, -poly.vertices.mean(axis=0))
+    thick = min(float(np.ptp(poly.vertices @ n)) for n in poly.normals)
+    poly = poly.transformed(np.eye(3), [0.0, 0.0, 0.001 - poly.vertices[:, 2].min()])
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1.8e9 / thick, friction_angle=30.0)
+    b.add_box(2.0, 2.0, 0.2, base_center=(0, 0, -0.2), driven=True, name="ground")
+    b.add_block(poly, density=1800.0, name=shape, velocity=(0.0, 0.0, -4.5))
+    ds = simulate(b.finalize(), 0.006, record_interval=2e-5, progress=False)
+    assert max_interpenetration(ds).relative < 0.02
+
+
 SHORT = ["edge_on_wall", "ridge_to_ridge", "ridge_impact", "random_pile", "topple_near_edge", "tip_over_edge", "corner_near_edge", "facade_topple"]
 
 

@@ -71,6 +71,31 @@ def test_triangular_face_points_lie_inside_and_conserve_area():
         assert np.all(wedge.contains(pts, tol=1e-9))
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_every_corner_of_a_random_face_is_an_interface_point_and_the_cells_tile_it(seed):
+    # Randomized cross-check against the face polygons themselves: with 2 or more points each way,
+    # every corner of every face of a random convex block carries a point (a corner landing alone
+    # must be held there), no point is repeated, the points lie on their face, and the cells sum to
+    # the face area (shoelace formula on the polygon, independent of the grid).
+    from rockdem.geometry import face_grid
+
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(int(rng.integers(6, 16)), 3))
+    poly = convex_hull(d / np.linalg.norm(d, axis=1)[:, None] * rng.uniform(0.05, 0.5, size=3))
+    for f, face in enumerate(poly.faces):
+        v = poly.vertices[face]
+        area = 0.5 * np.linalg.norm(sum(np.cross(v[i], v[(i + 1) % len(v)]) for i in range(len(v))))
+        size = np.ptp(v, axis=0).max()
+        for grid in [(2, 2), (3, 3), (2, 5)]:
+            g = face_grid(poly, f, *grid)
+            gaps = np.linalg.norm(v[:, None, :] - g.points[None, :, :], axis=2)  # (corners, points)
+            assert np.all(gaps.min(axis=1) <= 1e-9 * size)
+            assert len(np.unique(np.round(g.points / size, 9), axis=0)) == len(g.points)
+            assert np.all(poly.contains(g.points, tol=1e-9 * size))
+            assert g.areas.sum() == pytest.approx(area, rel=1e-6)
+            assert np.all(g.areas > 0.0)
+
+
 @pytest.mark.parametrize(
     "vertices,message",
     [
