@@ -451,9 +451,14 @@ def _law_range(
             area *= wgt
         if ended > 1.0:
             # The stiffening ended under load: the energy its springs held beyond the cell's own is
-            # dissipated (counted with the contacts' friction).
-            e_fric += 0.5 * area * (ended - 1.0) * (
-                kn * un * un + ks * (s.slot_shear[p, j, 0] ** 2 + s.slot_shear[p, j, 1] ** 2 + s.slot_shear[p, j, 2] ** 2))
+            # dissipated (counted with the contacts' friction). The leapfrog's work identity makes
+            # the spring energy of a stiffness k that acted up to the last step k u_prev u_now / 2
+            # at the switch (sum of F_n (x_n+1 - x_n-1) / 2 telescopes to the product), so that is
+            # what the stiffening leaves: with u_now^2 a parapet's face slapping down booked 275 J
+            # (balance +1.0 %), with u_prev^2 196 J (-1.2 %), with the product 232 J.
+            u_held = max(s.slot_overlap[p, j], 0.0) * max(un, 0.0)
+            e_fric += 0.5 * s.slot_area[p, j] * (1.0 - 1.0 / ended) * (
+                kn * u_held + ks * (s.slot_shear[p, j, 0] ** 2 + s.slot_shear[p, j, 1] ** 2 + s.slot_shear[p, j, 2] ** 2))
         sc.track_area[k] = area
         un_prev = s.slot_overlap[p, j]
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
