@@ -7,9 +7,10 @@ d)_j^2 / I_bj)) (principal body frame; 0 for a driven block), the row sum of blo
 sum u_b (u_b + u_o), an upper bound of omega^2 over the whole system. Then, per block,
 dt_b = (2 / omega_b) (sqrt(1 + xi^2) - xi), xi = beta omega_b / 2 (Belytschko), beta the largest
 of its joints. A sub-contact counts with its full cell area (the most its partner can cover) at its
-point (a landing corner with its stiffened area, :func:`rockdem.kernels.forces.corner_stiffening`), an edge contact with its area at the middle of its edge; tracked contacts include every
-one within the tracking tolerance, so the bound holds until the next detection, when it is
-computed again.
+point (a landing corner with its stiffened area, :func:`rockdem.kernels.forces.corner_stiffening`),
+an edge contact with its area at the middle of its edge; tracked contacts include every one
+within the tracking tolerance, so the bound holds until the next detection, when it is computed
+again.
 """
 
 from __future__ import annotations

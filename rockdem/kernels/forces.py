@@ -183,10 +183,11 @@ def corner_stiffening(
     It is kept while the contact stays compressed, until a neighbouring face corner comes down to
     the target plane while it still presses (``depth`` [m] > 0: the block came down onto an edge
     or its face, the corner is no longer alone), when it ends: the caller books the energy its
-    springs held beyond the cell's own as dissipated. Sub-contacts of a pair that was a pressed EDGE pair at the last detection (``s.pair_from_edge[i]``)
-    continue that contact and are not stiffened (as landing corners, 0.18 mm deep, they held 12.8 J
-    where the edge spring had held 1.7 J). Bonded sub-contacts are never stiffened, nor
-    any with explicit dashpots (whose step is bounded by Belytschko's factor, not the resolution)."""
+    springs held beyond the cell's own as dissipated. Sub-contacts of a pair that was a pressed
+    EDGE pair at the last detection (``s.pair_from_edge[i]``) continue that contact and are not
+    stiffened (as landing corners, 0.18 mm deep, they held 12.8 J where the edge spring had held
+    1.7 J). Bonded sub-contacts are never stiffened, nor any with explicit dashpots (whose step is
+    bounded by Belytschko's factor, not the resolution)."""
     if s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0:
         # Decided at the step it presses (still open: nothing acts, the bound uses landing_corner).
         if depth <= 0.0:
