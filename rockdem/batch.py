@@ -253,7 +253,9 @@ def batch_row(spec: Any) -> dict[str, Any]:
     case = case_of(data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        out = run_model(case.model, **run_options(case), progress=False, start=_start(data, case))
+        # One thread per run: a study spreads its runs over the cores (and Numba's default
+        # workqueue threads must not be started from two Dask worker threads at once).
+        out = run_model(case.model, **run_options(case), progress=False, start=_start(data, case), threads=1)
     row = summary_row(spec, data, frames_from_run(case, out))
     row["wall_s"] = time.perf_counter() - t0
     row["cpu_s"] = time.process_time() - c0

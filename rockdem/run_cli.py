@@ -15,7 +15,7 @@ import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
-from .cli import EXIT_DIVERGED, hold_signals, positive_float, stop_on_signals
+from .cli import EXIT_DIVERGED, hold_signals, positive_float, positive_int, stop_on_signals
 from .results import export_csv, save, write_contact_table
 from .simulation import simulate
 from .stopping import STOP_MODES
@@ -31,15 +31,16 @@ def run_case(
     initial: Checkpoint | str | os.PathLike[str] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float | None = None,
+    threads: int | None = None,
 ) -> xr.Dataset:
     """Run a built case with its own options (``duration`` overrides [run] duration).
 
     The loading's attributes (``case.attrs``) go into the result's attrs, its input series
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
-    ``initial``, ``checkpoint`` and ``checkpoint_every`` are :func:`~rockdem.simulation.simulate`'s.
+    ``initial``, ``checkpoint``, ``checkpoint_every`` and ``threads`` are :func:`~rockdem.simulation.simulate`'s.
     """
     ds = simulate(case.model, **run_options(case, duration), progress=progress, initial=initial, checkpoint=checkpoint,
-                  checkpoint_every=checkpoint_every)
+                  checkpoint_every=checkpoint_every, threads=threads)
     ds.attrs.update(case.attrs)
     t = ds.time.values
     for name, (ts, values) in case.series.items():
@@ -259,7 +260,7 @@ def _run(args: argparse.Namespace) -> int:
     received: list[int] = []
     with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
         ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False, initial=initial,
-                      checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every)
+                      checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every, threads=args.threads)
     wall = time.perf_counter() - t0
     with hold_signals(received, "saving the results computed so far"):
         written = [save(ds, out / "result.nc")]
@@ -319,4 +320,7 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
                    help="also write OUT/checkpoint.npz every SECONDS of wall time (always written at the end and "
                         "when stopped)")
     p.add_argument("--no-checkpoint", action="store_true", help="do not write OUT/checkpoint.npz")
+    p.add_argument("--threads", type=positive_int, metavar="N",
+                   help="threads for the joint law (default: all for models of 200 blocks or more, else 1; "
+                        "the same answer on any number)")
     p.set_defaults(func=_run)

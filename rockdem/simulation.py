@@ -37,12 +37,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping, NamedTuple, Sequence
 
+import numba
 import numpy as np
 import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
-from .kernels.step import DIVERGENCE_ERROR, advance
+from .kernels.step import DIVERGENCE_ERROR, advance, advance_parallel
 from .model import Model
 from .results import block_thickness, build_dataset
 from .snapshots import ContactSnapshots
@@ -58,7 +59,7 @@ from .timestep import (
     stable_timestep,
 )
 
-__all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "first_diverged_frame"]
+__all__ = ["simulate", "run_model", "prepare_start", "Start", "RunOutput", "Monitor", "DEFAULT_MAX_STEPS", "PARALLEL_MIN_BLOCKS", "first_diverged_frame"]
 
 Monitor = tuple[int | str, Sequence[float]]
 """A monitor point: (block id or name, world coordinates in the reference configuration [m])."""
@@ -87,6 +88,7 @@ def simulate(
     initial: Checkpoint | str | os.PathLike[str] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float | None = None,
+    threads: int | None = None,
 ) -> xr.Dataset:
     """Run ``model`` until time ``duration`` and return the recorded histories.
 
@@ -130,6 +132,10 @@ def simulate(
             under ``rockdem run``), and every ``checkpoint_every`` seconds of wall time; none is
             written for a run that diverged.
         checkpoint_every: wall time between checkpoints during the run [s]; default only at the end.
+        threads: threads for the joint law of the face pairs (Numba's, at most as many as it was
+            started with, ``NUMBA_NUM_THREADS``); the answer is the same bit for bit on any number.
+            Default None: all of them for models of at least :data:`PARALLEL_MIN_BLOCKS` blocks,
+            one (serial) below. The parallel code is compiled on its first use (a few minutes once).
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
@@ -142,7 +148,7 @@ def simulate(
     out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
                     dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
                     contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
-                    checkpoint=checkpoint, checkpoint_every=checkpoint_every)
+                    checkpoint=checkpoint, checkpoint_every=checkpoint_every, threads=threads)
     ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
     return out.snapshots.attach(ds)
 
@@ -204,6 +210,7 @@ def run_model(
     initial: Checkpoint | str | os.PathLike[str] | None = None,
     checkpoint: str | os.PathLike[str] | None = None,
     checkpoint_every: float | None = None,
+    threads: int | None = None,
 ) -> RunOutput:
     """:func:`simulate` without building the Dataset: the raw recorded frames and attributes
     (studies summarise these directly; same arguments). ``attrs["kernel_s"]`` is the time spent
@@ -223,6 +230,8 @@ def run_model(
             raise ValueError("checkpoint_every needs a checkpoint file: give checkpoint=PATH")
     mon = _check_monitors(model, monitors or {})
     rule = stop_rule(stop)
+    n_threads = _threads(threads, model.block_count)
+    step_chunk = advance_parallel if n_threads > 1 else advance
     if start is not None and initial is not None:
         raise ValueError("give start (a prepared fresh start) or initial (a checkpoint), not both")
     ck = None if initial is None else load_checkpoint(initial)
@@ -264,7 +273,7 @@ def run_model(
                 else:
                     t_stop = snaps.clip(min(t_end, float(state.time[0]) + chunk))
                 t0 = _time.perf_counter()
-                frame, status = advance(m, state, scratch, t_stop, run.record_interval, rec, frame)
+                frame, status = _on_threads(n_threads, step_chunk, m, state, scratch, t_stop, run.record_interval, rec, frame)
                 elapsed = _time.perf_counter() - t0
                 kernel += elapsed
                 if status == STATUS_GROW:
@@ -309,6 +318,7 @@ def run_model(
         "dashpot_unconverged_steps": int(state.dashpot_unconverged[0]),
         "steps": int(state.step[0]),
         "sub_contact_updates": int(state.slot_updates[0]),
+        "threads": n_threads,
         "runtime_s": runtime,
         "kernel_s": kernel,
         "duration": duration,
@@ -530,6 +540,37 @@ def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | 
         f"stiffness kn = {m.mat_kn[m.block_group[owner[k]], m.block_group[other[k]]]:.3g} Pa/m is far too low for the load "
         "(kn = E / l with E in Pa, not MPa)"
     )
+
+
+PARALLEL_MIN_BLOCKS = 200
+"""Models with at least this many blocks run the joint law on all of Numba's threads by default
+(``threads`` of :func:`simulate`); smaller ones run serially (a step of a few blocks is shorter
+than waking the threads)."""
+
+
+def _threads(threads: int | None, blocks: int) -> int:
+    """The number of threads a run uses (``threads`` of :func:`simulate`)."""
+    available = numba.config.NUMBA_NUM_THREADS
+    if threads is None:
+        return available if blocks >= PARALLEL_MIN_BLOCKS else 1
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise ValueError(f"threads must be a positive integer (or None: automatic), got {threads!r}")
+    if threads > available:
+        raise ValueError(f"threads = {threads} is more than the {available} threads Numba was started with: give at most "
+                         f"{available}, or set NUMBA_NUM_THREADS before starting Python")
+    return int(threads)
+
+
+def _on_threads(n: int, step_chunk: Any, *args: Any) -> Any:
+    """``step_chunk(*args)`` on ``n`` of Numba's threads (the caller's setting restored after)."""
+    if n == 1:
+        return step_chunk(*args)
+    before = numba.get_num_threads()
+    numba.set_num_threads(n)
+    try:
+        return step_chunk(*args)
+    finally:
+        numba.set_num_threads(before)
 
 
 def _positive_number(name: str, value: Any, unit: str) -> float:

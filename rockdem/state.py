@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels.detect import bond_touching, detect, update_rotations
-from .kernels.layout import ENERGY_COUNT, FAILED_NONE, SLOTS, Scratch, State
+from .kernels.layout import ENERGY_COUNT, FAILED_NONE, LAW_CHUNKS, SLOTS, Scratch, State
 from .model import Model
 
 __all__ = ["initial_state", "grow_buffers"]
@@ -44,6 +44,15 @@ def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
         "pair_dashpot_velocity": np.zeros((count, 3)),
         "pair_weight": np.zeros(count),
         "pair_bonded": np.zeros(count, dtype=np.bool_),
+        "pair_asks_detection": np.zeros(count, dtype=np.bool_),
+        "side_force": np.zeros((count, 2, 3)),
+        "side_moment": np.zeros((count, 2, 3)),
+        "side_elastic": np.zeros((count, 2)),
+        "side_friction": np.zeros((count, 2)),
+        "side_bond": np.zeros((count, 2)),
+        "side_active": np.zeros((count, 2), dtype=i64),
+        "side_released": np.zeros((count, 2), dtype=i64),
+        "side_failed": np.zeros((count, 2), dtype=i64),
         "blend_force_owner": np.zeros((count, 3)),
         "blend_point_owner": np.zeros((count, 3)),
         "blend_force_target": np.zeros((count, 3)),
@@ -149,6 +158,8 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         pending_pair=np.zeros(SLOTS * n_pts, dtype=np.int64),
         release_overlap=np.zeros(SLOTS * n_pts),
         release_area=np.zeros(SLOTS * n_pts),
+        track_released=np.zeros(SLOTS * n_pts, dtype=np.bool_),
+        track_failed=np.zeros(SLOTS * n_pts, dtype=np.int64),
         velocity_mid=np.zeros((nb, 3)),
         omega_mid=np.zeros((nb, 3)),
         block_damping=np.zeros((nb, 6, 6)),
@@ -159,6 +170,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         block_damped=np.zeros(nb, dtype=np.bool_),
         driven_velocity_last=np.zeros((nb, 3)),
         poly=np.zeros((2, 32, 2)),
+        chunk_poly=np.zeros((LAW_CHUNKS, 2, 32, 2)),
         prev_pair_count=np.zeros(1, dtype=np.int64),
         energy_scale=one.copy(),
         lost_block=np.full(1, -1, dtype=np.int64),

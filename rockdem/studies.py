@@ -252,7 +252,7 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     case = parse_case(data)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ds = run_case(case, progress=False)
+        ds = run_case(case, progress=False, threads=1)  # one thread per run, as on the batch path
     row = summary_row(spec, data, frames_from_dataset(ds))
     row["wall_s"] = time.perf_counter() - t0
     row["cpu_s"] = time.process_time() - c0

@@ -228,3 +228,21 @@ def test_citation_file_matches_the_package_and_cites_the_paper():
     assert "cff-version: 1.2.0" in text
     assert f"\nversion: {rockdem.__version__}\n" in text
     assert "doi: 10.1002/eqe.3598" in text and "Damping considerations for rocking block dynamics" in text
+
+
+def test_threads_option(tmp_path, capsys):
+    """--threads N runs the joint law on N threads (the result says so); a bad count is refused
+    with the option named, without a traceback."""
+    import numba
+
+    out = tmp_path / "t"
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.2", "--quiet", "--no-plot",
+                 "--threads", "1"]) == 0
+    assert load(out / "result.nc").attrs["threads"] == 1
+    capsys.readouterr()
+    assert main(["run", "--example", "free-rocking", "--threads", "0"]) == 2
+    assert "--threads" in capsys.readouterr().err
+    too_many = str(numba.config.NUMBA_NUM_THREADS + 1)
+    assert main(["run", "--example", "free-rocking", "--out", str(tmp_path / "u"), "--threads", too_many, "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "NUMBA_NUM_THREADS" in err and "Traceback" not in err

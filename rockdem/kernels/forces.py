@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import njit
 
@@ -32,8 +33,10 @@ from .layout import (
     DASHPOTS_IMPLICIT,
     E_BOND,
     E_FRICTION,
+    FAILED_NONE,
     FAILED_SHEAR,
     FAILED_TENSION,
+    LAW_CHUNKS,
     PAIR_EDGE,
     SLOTS,
     ModelArrays,
@@ -41,6 +44,7 @@ from .layout import (
     State,
 )
 from .series import interpolate
+from .variants import rebind
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -307,79 +311,145 @@ def _faces(s: State, i: int, side: int) -> tuple[int, int]:
     return s.pair_target_face[i], s.pair_owner_face[i]
 
 
-@njit(cache=True, _nrt=False)
-def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float) -> tuple[float, int, float, float, int]:
-    """The cover and joint law of every sub-contact of the face pairs: stores its force
-    and point (``sc.contact_force``, ``sc.contact_point``, ``sc.dashpot_force``) and lists those
-    that opened during the last step in ``sc.pending`` for :func:`_release_pass`.
+@njit(cache=True, _nrt=False, inline="always")
+def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray) -> None:
+    """The cover and joint law of the sub-contacts of FACE pair i (``buf``: a (2, 32, 2) polygon
+    buffer of the calling thread's own). Writes only pair i's entries: its sub-contacts' slots,
+    forces and flags (``sc.track_released``, ``sc.track_failed``) and per side the resultant,
+    energies and counts (``sc.side_*``) that :func:`_gather` adds up in pair order, so that pairs
+    may run in parallel with the serial answer bit for bit.
 
-    Returns (elastic energy, active count, friction and bond energy dissipated, opened count).
-    Performance note: this loop calls only small inlined functions and makes no array views. A
-    call to a compiled function, or an inlined one with loops of its own (a clipping, a
-    quadrature), anywhere in it stops Numba from pruning the reference counting of every array it
-    touches, which made it ten times slower: such rare work is done in the other passes. The joint
-    law (:func:`_law_range`) is inlined by Numba at a single call site: a compiled call that passes
-    the model, state and scratch tuples unpacks some 900 array fields per pair side (about 4,500
+    Performance note: the joint law (:func:`_law_range`) calls only small inlined functions and
+    makes no array views. A call to a compiled function, or an inlined one with loops of its own
+    (a clipping, a quadrature), anywhere in it stops Numba from pruning the reference counting of
+    every array it touches, which made it ten times slower: such rare work is done out of line.
+    The law is inlined by Numba at a single call site: a compiled call that passes the model,
+    state and scratch tuples unpacks some 900 array fields per pair side (about 4,500
     instructions), which made the 1000-brick wall's force pass 2.2x slower wherever LLVM chose not
     to inline it (2.5 against 1.16 ms per step, measured on the corner-stiffening branch).
     """
+    fa = s.pair_owner_face[i]
+    fb = s.pair_target_face[i]
+    a = m.face_block[fa]
+    b = m.face_block[fb]
+    split = s.pair_track_split[i]
+    stop = s.pair_track_stop[i]
+    lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
+    # The owner's points on the target face, then (while the pair may blend) the target's on
+    # the owner face: one call site, so that the inlined joint law is compiled once.
+    u_owner = 0.0
+    for side in range(2 if split < stop else 1):
+        if side == 0:
+            k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
+        else:
+            k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
+        u_side = _law_range(m, s, sc, i, side, k0, k1, fo, ft, o, t, wgt, blending, dt, implicit, dashpots, buf)
+        if side == 0:
+            u_owner = u_side
+        elif dlam != 0.0:
+            # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
+            g = (u_side - u_owner) * dlam
+            for c in range(3):
+                sc.blend_force_owner[i, c] *= g
+                sc.blend_force_target[i, c] *= g
+
+
+@njit(cache=True, _nrt=False)
+def _law_pairs(
+    m: ModelArrays, s: State, sc: Scratch, first: int, last: int, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray
+) -> None:
+    """:func:`_law_pair` for FACE pairs first..last - 1, in order (``buf`` as there). The joint law
+    is compiled here once, for the serial and the parallel pass alike."""
+    for i in range(first, last):
+        if s.pair_kind[i] != PAIR_EDGE:
+            _law_pair(m, s, sc, i, dt, implicit, dashpots, buf)
+
+
+@njit(cache=True, _nrt=False)
+def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, implicit: bool, dashpots: bool) -> None:
+    """The joint law of every FACE pair (:func:`_law_pairs`), on the calling thread."""
+    _law_pairs(m, s, sc, 0, s.pair_count[0], dt, implicit, dashpots, sc.poly)
+
+
+@njit(cache=True, _nrt=False, parallel=True)
+def _law_pass_parallel(m: ModelArrays, s: State, sc: Scratch, dt: float, implicit: bool, dashpots: bool) -> None:
+    """:func:`_law_pass` over LAW_CHUNKS fixed chunks of the pairs on Numba's threads (the same
+    answer on any number of threads: every pair writes only its own entries). Each chunk is one
+    call of the compiled :func:`_law_pairs`: the law inlined into the loop of a ``parallel=True``
+    function lost its writes to the state's arrays (Numba 0.68's parfor passes took them for dead
+    code), and it compiled slowly."""
+    n = s.pair_count[0]
+    per = (n + LAW_CHUNKS - 1) // LAW_CHUNKS
+    for chunk in numba.prange(LAW_CHUNKS):
+        _law_pairs(m, s, sc, min(n, chunk * per), min(n, (chunk + 1) * per), dt, implicit, dashpots, sc.chunk_poly[chunk])
+
+
+@njit(cache=True, _nrt=False)
+def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, float, int]:
+    """Add up, in pair order, what :func:`_law_pair` left per pair side: the resultants on the two
+    blocks, the energies and counts, the failed bonds (``s.point_failed``), the sub-contacts that
+    opened during the last step (listed in ``sc.pending`` for :func:`_release_pass`) and the
+    detections asked for (:func:`_blend`).
+
+    Returns (elastic energy, active count, friction and bond energy dissipated, opened count)."""
     elastic = 0.0
     active = 0
     e_fric = 0.0
     e_bond = 0.0
     nrel = 0
-    implicit = s.dashpots[0] == DASHPOTS_IMPLICIT
-    dashpots = has_dashpots(m)
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
-        fa = s.pair_owner_face[i]
-        fb = s.pair_target_face[i]
-        a = m.face_block[fa]
-        b = m.face_block[fb]
+        a = m.face_block[s.pair_owner_face[i]]
+        b = m.face_block[s.pair_target_face[i]]
+        if sc.pair_asks_detection[i]:
+            sc.pair_asks_detection[i] = False
+            s.moved[a] = max(s.moved[a], m.contact_tol)
+            s.moved[b] = max(s.moved[b], m.contact_tol)
         split = s.pair_track_split[i]
-        stop = s.pair_track_stop[i]
-        lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
-        # The owner's points on the target face, then (while the pair may blend) the target's on
-        # the owner face: one call site, so that the inlined joint law is compiled once.
-        u_owner = 0.0
-        for side in range(2 if split < stop else 1):
-            if side == 0:
-                k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
-            else:
-                k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
-            el, ac, ef, eb, nrel, u_side = _law_range(m, s, sc, i, k0, k1, fo, ft, o, t, wgt, blending, dt, nrel, implicit, dashpots)
-            elastic += el
-            active += ac
-            e_fric += ef
-            e_bond += eb
-            if side == 0:
-                u_owner = u_side
-            elif dlam != 0.0:
-                # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
-                g = (u_side - u_owner) * dlam
-                for c in range(3):
-                    sc.blend_force_owner[i, c] *= g
-                    sc.blend_force_target[i, c] *= g
+        for side in range(2 if split < s.pair_track_stop[i] else 1):
+            o, t = (a, b) if side == 0 else (b, a)
+            elastic += sc.side_elastic[i, side]
+            active += sc.side_active[i, side]
+            e_fric += sc.side_friction[i, side]
+            e_bond += sc.side_bond[i, side]
+            f = sc.side_force[i, side]
+            q = sc.side_moment[i, side]
+            _apply_resultant(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f[0], f[1], f[2], q[0], q[1], q[2])
+            if sc.side_failed[i, side] == 0 and sc.side_released[i, side] == 0:
+                continue
+            k0, k1 = (s.pair_track_start[i], split) if side == 0 else (split, s.pair_track_stop[i])
+            for k in range(k0, k1):
+                if sc.track_failed[k] != FAILED_NONE:
+                    s.point_failed[s.track[k] // SLOTS] = sc.track_failed[k]
+                    sc.track_failed[k] = FAILED_NONE
+                if sc.track_released[k]:
+                    sc.track_released[k] = False
+                    sc.pending[nrel] = k
+                    sc.pending_pair[nrel] = i
+                    nrel += 1
     return elastic, active, e_fric, e_bond, nrel
 
 
 @njit(cache=True, _nrt=False, inline="always")
 def _law_range(
-    m: ModelArrays, s: State, sc: Scratch, i: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, nrel: int, implicit: bool, dashpots: bool,
-) -> tuple[float, int, float, float, int, float]:
+    m: ModelArrays, s: State, sc: Scratch, i: int, side: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
+    wgt: float, blending: bool, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray,
+) -> float:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
     False: the whole pair, wgt 1). With ``implicit`` dashpots (:mod:`rockdem.kernels.implicit`) only
     half the dashpot force at the last half step's velocity is applied here and each active
-    dashpot is stored (``sc.dashpot_*``) for the velocity solve. Returns (elastic energy, active count, friction and bond energy
-    dissipated, the new opened count, the normal spring energy at full share)."""
+    dashpot is stored (``sc.dashpot_*``) for the velocity solve. Leaves the side's resultant on
+    block o (moment about its centroid), energies and counts in ``sc.side_*[i, side]``; returns
+    the normal spring energy at full share."""
     elastic = 0.0
     active = 0
     e_fric = 0.0
     e_bond = 0.0
     u_side = 0.0
+    released = 0
+    failed = 0
     sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = 0.0
     fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
     # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
@@ -404,7 +474,7 @@ def _law_range(
         else:
             unbonded = not s.slot_bonded[p, j]
             full_area, yu, yw, shift = cut_cell(
-                m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
+                m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
                 unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
@@ -486,7 +556,8 @@ def _law_range(
             # Tension cut-off: the bond fails and the point opens.
             e_bond += spring_energy(fn, kna) + 0.5 * ksa * (us0 * us0 + us1 * us1 + us2 * us2)
             s.slot_bonded[p, j] = False
-            s.point_failed[p] = FAILED_TENSION
+            sc.track_failed[k] = FAILED_TENSION
+            failed += 1
             opened = True
             bonded = False
             prev_area = 0.0  # its energy is counted
@@ -496,15 +567,15 @@ def _law_range(
             if bonded:
                 e_bond += e + (spring_energy(s.slot_normal_force[p, j], kn * prev_area) if prev_area > 0.0 else 0.0)
                 s.slot_bonded[p, j] = False
-                s.point_failed[p] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
+                sc.track_failed[k] = FAILED_SHEAR if un > 0.0 else FAILED_TENSION
+                failed += 1
             elif area > 0.0 and un_prev > 0.0 and prev_area > 0.0:
                 # Opened during the last step: its release is computed apart (release pass), its
                 # shear extension kept until then.
-                sc.pending[nrel] = k
-                sc.pending_pair[nrel] = i
-                sc.release_overlap[nrel] = un_prev
-                sc.release_area[nrel] = prev_area
-                nrel += 1
+                sc.track_released[k] = True
+                sc.release_overlap[k] = un_prev
+                sc.release_area[k] = prev_area
+                released += 1
                 s.slot_normal_force[p, j] = 0.0
                 continue
             else:
@@ -537,7 +608,8 @@ def _law_range(
             if bonded:
                 # Shear failure: drop to the residual strength; the released energy is the bond's.
                 s.slot_bonded[p, j] = False
-                s.point_failed[p] = FAILED_SHEAR
+                sc.track_failed[k] = FAILED_SHEAR
+                failed += 1
                 fres = min(coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], area, fn), fmax)
                 e_bond += drop_dissipation(fmax, fres, ksa)
                 fmax = fres
@@ -599,8 +671,19 @@ def _law_range(
         sm0 += r1 * f2 - r2 * f1
         sm1 += r2 * f0 - r0 * f2
         sm2 += r0 * f1 - r1 * f0
-    _apply_resultant(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, sf0, sf1, sf2, sm0, sm1, sm2)
-    return elastic, active, e_fric, e_bond, nrel, u_side
+    sc.side_force[i, side, 0] = sf0
+    sc.side_force[i, side, 1] = sf1
+    sc.side_force[i, side, 2] = sf2
+    sc.side_moment[i, side, 0] = sm0
+    sc.side_moment[i, side, 1] = sm1
+    sc.side_moment[i, side, 2] = sm2
+    sc.side_elastic[i, side] = elastic
+    sc.side_active[i, side] = active
+    sc.side_friction[i, side] = e_fric
+    sc.side_bond[i, side] = e_bond
+    sc.side_released[i, side] = released
+    sc.side_failed[i, side] = failed
+    return u_side
 
 
 @njit(cache=True, _nrt=False)
@@ -620,9 +703,8 @@ def _blend(m: ModelArrays, s: State, sc: Scratch, i: int, fa: int, fb: int, a: i
     )
     clarity = sep_o - sep_t
     if split == s.pair_track_stop[i]:
-        if tracks_target(clarity, m.contact_tol):  # not tracked yet: detect at the next step
-            s.moved[a] = max(s.moved[a], m.contact_tol)
-            s.moved[b] = max(s.moved[b], m.contact_tol)
+        if tracks_target(clarity, m.contact_tol):  # not tracked yet: detect at the next step (_gather)
+            sc.pair_asks_detection[i] = True
         return 0.0, 0.0
     lam, dlam = blend_weight(clarity, m.contact_tol)
     sc.pair_weight[i] = lam
@@ -671,8 +753,8 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
     for q in range(nrel):
         k = sc.pending[q]
         i = sc.pending_pair[q]
-        un_prev = sc.release_overlap[q]
-        prev_area = sc.release_area[q]
+        un_prev = sc.release_overlap[k]
+        prev_area = sc.release_area[k]
         fo, ft = _faces(s, i, 0 if k < s.pair_track_split[i] else 1)
         fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
         o = m.face_block[fo]
@@ -814,7 +896,8 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
 def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
     """Forces and torques on every block at the current poses (joint law of paper §3); ``t`` [s] is
     the time at which body loads (inertial earthquake loading) are sampled, ``dt`` [s] the step
-    just taken."""
+    just taken. (:data:`compute_forces_parallel`: the same with the face pairs' law on Numba's
+    threads, the same answer bit for bit.)"""
     nb = m.block_mass.shape[0]
     sc.force[:] = 0.0
     sc.torque[:] = 0.0
@@ -827,7 +910,8 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
         if m.block_free[b]:
             for i in range(3):
                 sc.force[b, i] = m.block_mass[b] * (m.gravity[i] + sc.body_acc[i])
-    elastic, active, e_fric, e_bond, nrel = _law_pass(m, s, sc, dt)
+    _law_pass(m, s, sc, dt, s.dashpots[0] == DASHPOTS_IMPLICIT, has_dashpots(m))
+    elastic, active, e_fric, e_bond, nrel = _gather(m, s, sc)
     if nrel > 0:
         e_fric += _release_pass(m, s, sc, nrel, dt)
     for i in range(s.pair_count[0]):
@@ -843,3 +927,9 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
     s.energy[E_BOND] += e_bond
 
 
+
+
+compute_forces_parallel = njit(cache=True, _nrt=False)(
+    rebind(compute_forces.py_func, "compute_forces_parallel", _law_pass=_law_pass_parallel)
+)
+"""(m, s, sc, t, dt) -> None: :func:`compute_forces` with :func:`_law_pass_parallel`."""

@@ -27,6 +27,11 @@ FAILED_SHEAR = 2
 PAIR_FACE = 0
 PAIR_EDGE = 1
 
+LAW_CHUNKS = 64
+"""Fixed chunks of the face pairs in the parallel law pass (kernels.forces), each with its own
+polygon buffer (``Scratch.chunk_poly``): the work splits over up to this many threads, and the
+answer does not depend on how many there are."""
+
 SLOTS = 2
 """Partners a point can hold at once (a point on the shared edge of two faces of its partners)."""
 
@@ -231,8 +236,10 @@ class Scratch(NamedTuple):
     track_depth_shift: np.ndarray  # (SLOTS np,) [m] overlap at the force point minus its overlap (<= 0, faces.partly_covered)
     pending: np.ndarray  # (SLOTS np,) int64 tracked sub-contacts left for a later pass
     pending_pair: np.ndarray  # (SLOTS np,) int64 their pairs
-    release_overlap: np.ndarray  # (SLOTS np,) [m] overlap at the previous step of each opened one
-    release_area: np.ndarray  # (SLOTS np,) [m^2] its area at the previous step
+    release_overlap: np.ndarray  # (SLOTS np,) [m] per tracked sub-contact that opened during the last step: its overlap then
+    release_area: np.ndarray  # (SLOTS np,) [m^2] ... and its area then
+    track_released: np.ndarray  # (SLOTS np,) bool it opened during the last step (from the law pass to its gather)
+    track_failed: np.ndarray  # (SLOTS np,) int64 FAILED_* of its bond failing at this step (law pass to gather)
     pair_force: np.ndarray  # (P, 3) [N] EDGE pairs: force on block a
     pair_point: np.ndarray  # (P, 3) [m] its point of application
     pair_dashpot_force: np.ndarray  # (P, 3) [N] EDGE pairs: the SP dashpot part
@@ -241,6 +248,16 @@ class Scratch(NamedTuple):
     pair_dashpot_velocity: np.ndarray  # (P, 3) [m/s] EDGE pairs: relative velocity of a to b at the last half step
     pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
+    pair_asks_detection: np.ndarray  # (P,) bool FACE: its target's points are needed but not tracked (law pass to gather)
+    # FACE pairs per side (0: the owner's points, 1: the target's), from the law pass to its gather:
+    side_force: np.ndarray  # (P, 2, 3) [N] resultant of the side's sub-contact forces on its pressing block
+    side_moment: np.ndarray  # (P, 2, 3) [N m] their moment about that block's centroid
+    side_elastic: np.ndarray  # (P, 2) [J] spring energy
+    side_friction: np.ndarray  # (P, 2) [J] friction dissipated at this step
+    side_bond: np.ndarray  # (P, 2) [J] bond energy released at this step
+    side_active: np.ndarray  # (P, 2) int64 active sub-contacts
+    side_released: np.ndarray  # (P, 2) int64 sub-contacts that opened during the last step
+    side_failed: np.ndarray  # (P, 2) int64 bonds that failed at this step
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
     blend_point_owner: np.ndarray  # (P, 3) [m] ... at this point (minus it on the target's block)
     blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block
@@ -257,6 +274,7 @@ class Scratch(NamedTuple):
     driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots)
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
     poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
+    chunk_poly: np.ndarray  # (LAW_CHUNKS, 2, 32, 2) the same for each chunk of the parallel law pass
     cand_code: np.ndarray  # (C,) int64 detection: candidate point p (slot assigned later)
     cand_partner: np.ndarray  # (C,) int64
     cand_face: np.ndarray  # (C,) int64 target face

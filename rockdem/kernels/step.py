@@ -26,7 +26,7 @@ from numba import njit
 
 from .bound import contact_bound
 from .detect import detect, edge_pairs_changed, update_rotations
-from .forces import compute_forces
+from .forces import compute_forces, compute_forces_parallel
 from .implicit import couple, factor_block, finalize, has_dashpots, mark_damped, solve_block, sweep
 from .layout import (
     DASHPOTS_EXPLICIT,
@@ -54,6 +54,7 @@ from .layout import (
 )
 from .rotation import quat_integrate, quat_integrate_xyz
 from .series import interpolate
+from .variants import rebind
 
 DIVERGENCE_ERROR = 0.2
 """Energy-balance error, as a fraction of the run's energy scale so far, that marks a divergence."""
@@ -518,3 +519,10 @@ def advance(
             if status != STATUS_DONE:
                 return frame, status
     return frame, STATUS_DONE
+
+
+advance_parallel = njit(cache=True, _nrt=False)(rebind(advance.py_func, "advance_parallel", compute_forces=compute_forces_parallel))
+"""(m, s, sc, t_stop, record_interval, rec, frame) -> (frame, status): :func:`advance` with the face
+pairs' joint law on Numba's threads (:func:`rockdem.kernels.forces.compute_forces_parallel`): the
+same answer bit for bit on any number of threads. Compiled on first use only (``parallel=True``
+code compiles slowly)."""
