@@ -136,6 +136,9 @@ def simulate(
             started with, ``NUMBA_NUM_THREADS``); the answer is the same bit for bit on any number.
             Default None: all of them for models of at least :data:`PARALLEL_MIN_BLOCKS` blocks,
             one (serial) below. The parallel code is compiled on its first use (a few minutes once).
+            Runs made at once from several Python threads should give 1: Numba's default
+            ``workqueue`` threading layer does not take parallel work from two threads at a time
+            (the study runners, :mod:`rockdem.batch`, run one thread per run).
 
     Returns:
         An xarray Dataset (see :func:`rockdem.results.build_dataset` for the variables).
