@@ -365,10 +365,13 @@ def _law_pairs(
             _law_pair(m, s, sc, i, dt, implicit, dashpots, buf)
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, implicit: bool, dashpots: bool) -> None:
     """The joint law of every FACE pair (:func:`_law_pairs`), on the calling thread."""
-    _law_pairs(m, s, sc, 0, s.pair_count[0], dt, implicit, dashpots, sc.poly)
+    n = s.pair_count[0]
+    # min(n, 0), not a literal 0: Numba would compile the law a second time for Literal[int](0),
+    # beside the int64 bounds of the parallel pass (two minutes more at its first use).
+    _law_pairs(m, s, sc, min(n, 0), n, dt, implicit, dashpots, sc.poly)
 
 
 @njit(cache=True, _nrt=False, parallel=True)
@@ -892,7 +895,7 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     return spring_energy(fn, kna) + spring_energy(min(trial, fmax), ksa), 1, e_fric
 
 
-@njit(cache=True, _nrt=False)
+@njit(cache=True, _nrt=False, inline="always")
 def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -> None:
     """Forces and torques on every block at the current poses (joint law of paper §3); ``t`` [s] is
     the time at which body loads (inertial earthquake loading) are sampled, ``dt`` [s] the step
@@ -929,7 +932,7 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
 
 
 
-compute_forces_parallel = njit(cache=True, _nrt=False)(
+compute_forces_parallel = njit(cache=True, _nrt=False, inline="always")(
     rebind(compute_forces.py_func, "compute_forces_parallel", _law_pass=_law_pass_parallel)
 )
 """(m, s, sc, t, dt) -> None: :func:`compute_forces` with :func:`_law_pass_parallel`."""
