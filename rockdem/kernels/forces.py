@@ -380,7 +380,7 @@ def _law_pass_parallel(m: ModelArrays, s: State, sc: Scratch, dt: float, implici
     answer on any number of threads: every pair writes only its own entries). Each chunk is one
     call of the compiled :func:`_law_pairs`: the law inlined into the loop of a ``parallel=True``
     function lost its writes to the state's arrays (Numba 0.68's parfor passes took them for dead
-    code), and it compiled slowly."""
+    code)."""
     n = s.pair_count[0]
     per = (n + LAW_CHUNKS - 1) // LAW_CHUNKS
     for chunk in numba.prange(LAW_CHUNKS):
