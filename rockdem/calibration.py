@@ -30,7 +30,8 @@ import pandas as pd
 from .analysis import wme
 from .plots import save_figure
 from .batch import batch_row
-from .studies import RunSpec, execute, resolve_base, with_stop
+from .case import parse_assignment
+from .studies import RunSpec, check_first_run, execute, resolve_base, with_stop
 
 __all__ = ["Reference", "load_reference", "reference_from_row", "CalibrationResult", "calibrate", "wme_of_row", "register_cli"]
 
@@ -207,6 +208,8 @@ def calibrate(
     def spec(values: Sequence[float]) -> RunSpec:
         return RunSpec.make(base_d, {**(fixed or {}), **dict(zip(keys, values))}, duration=dur, history=True)
 
+    check_first_run([spec([b[0] for b in bnds])], "the calibration")
+
     def record(s: RunSpec, row: Mapping[str, Any], values: Sequence[float]) -> float:
         if s.id not in cache:
             cache[s.id] = wme_of_row(row, reference)
@@ -324,15 +327,7 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
 
 def _calibrate_cli(args: argparse.Namespace) -> int:
     ref = load_reference(args.reference, quantity=args.quantity)
-    fixed: dict[str, Any] = {}
-    for item in args.set or []:
-        k, _, v = item.partition("=")
-        import tomllib
-
-        try:
-            fixed[k.strip()] = tomllib.loads(f"v = {v}")["v"]
-        except tomllib.TOMLDecodeError:
-            fixed[k.strip()] = v
+    fixed = dict(parse_assignment(item) for item in args.set or [])
     res = calibrate(args.base, args.parameter, args.bounds, ref, fixed=fixed, duration=args.duration,
                     log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
                     workers=args.workers, scheduler=args.scheduler, stop=args.stop)

@@ -45,6 +45,7 @@ __all__ = [
     "example_names",
     "example_case",
     "apply_overrides",
+    "parse_assignment",
     "read_toml",
     "parse_toml_value",
     "check_plausible",
@@ -454,6 +455,18 @@ def example_case(name: str) -> dict[str, Any]:
     return data
 
 
+def parse_assignment(item: str) -> tuple[str, Any]:
+    """One ``table.key=value`` override (``--set``): the dotted key and the value, parsed as TOML,
+    else kept as a string. A missing ``=`` or an empty key is refused with the form to use."""
+    if not isinstance(item, str) or "=" not in item:
+        raise ValueError(f"--set {item!r}: use table.key=value, e.g. damping.beta=0.005")
+    path, value = item.split("=", 1)
+    parsed = parse_toml_value(value, f"--set {path.strip()}")
+    if not all(k.strip() for k in path.strip().split(".")):
+        raise ValueError(f"--set {item[:60]!r}: use table.key=value, e.g. damping.beta=0.005")
+    return path.strip(), parsed
+
+
 def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, Any]:
     """Apply ``table.key=value`` overrides (value parsed as TOML, else kept as a string)."""
     if not isinstance(data, Mapping):
@@ -462,13 +475,8 @@ def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, 
         raise ValueError(f"overrides must be a list of 'table.key=value' strings, got {_short(overrides)}")
     out = copy.deepcopy(dict(data))
     for item in overrides:
-        if "=" not in item:
-            raise ValueError(f"--set {item!r}: use table.key=value, e.g. damping.beta=0.005")
-        path, value = item.split("=", 1)
-        parsed = parse_toml_value(value, f"--set {path.strip()}")
-        keys = path.strip().split(".")
-        if not all(k.strip() for k in keys):
-            raise ValueError(f"--set {item[:60]!r}: use table.key=value, e.g. damping.beta=0.005")
+        path, parsed = parse_assignment(item)
+        keys = path.split(".")
         node = out
         for k in keys[:-1]:
             node = node.setdefault(k, {})

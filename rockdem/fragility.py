@@ -31,6 +31,7 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.stats import norm
 
+from .case import parse_assignment, parse_case
 from .intensity import IM_COLUMNS, response_spectrum, rocking_period, spec_intensities
 from .loading import earthquake_record
 from .plots import save_figure
@@ -228,6 +229,23 @@ def characteristic_period(specs: Sequence[RunSpec]) -> float | None:
         return None
 
 
+def _check_cases(specs: Sequence[RunSpec], per_record: int) -> None:
+    """Refuse an IDA none of whose runs can start, before any run: the first run of each record is
+    built (not run) until one is a valid case. A bad base case or ``fixed`` value thus errors at
+    once, while a record that cannot be read errors only its own runs (reported apart)."""
+    first: Exception | None = None
+    for spec in specs[::per_record]:
+        try:
+            parse_case(spec.case_dict())
+            return
+        except (ValueError, FileNotFoundError) as exc:
+            first = first or exc
+    if first is not None:
+        n = len(specs) // per_record
+        raise ValueError(f"no run of the IDA can start ({'its record' if n == 1 else f'none of its {n} records'} gives a "
+                         f"valid case; nothing was run): {first}")
+
+
 def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], out: str | os.PathLike[str], *,
             fixed: Mapping[str, Any] | None = None, duration: float | None = None, drift_limit: float | None = None,
             im: str = "pga_g", period: float | None = None, stop: str = "decided", executor: str = "process",
@@ -249,14 +267,19 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
         batch: the batch path (identical rows, faster); False runs each spec as a single run.
 
     Raises:
-        ValueError: an unknown ``im``, or no run completed (the table is written first; the
-            message gives the first error).
+        ValueError: an unknown ``im``; no record or PGA level; no run can start (the first run of
+            every record is not a valid case: a bad base case or ``fixed`` value; nothing is run
+            or written); or no run completed (the table is written first; the message gives the
+            first error).
     """
     if im not in IM_COLUMNS:
         raise ValueError(f"im must be one of {list(IM_COLUMNS)}, got {im!r}")
     if period is not None and not (np.isfinite(period) and period > 0):
         raise ValueError(f"period must be a positive time [s], got {period!r}")
+    if isinstance(records, str) or len(records) == 0 or len(pga_g) == 0:
+        raise ValueError(f"give a list of at least one record and one PGA level [g], got records={records!r}, pga_g={pga_g!r}")
     specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration, stop=stop)
+    _check_cases(specs, len(pga_g))
     store = Store(out)
     execute(specs, store, executor=executor, workers=workers, scheduler=scheduler, progress=progress, batch=batch)
     df = study_table(store, specs=specs)
@@ -492,15 +515,7 @@ def write_report(table: pd.DataFrame, fits: pd.DataFrame, out: Path, *, drift_li
 
 
 def _fragility_cli(args: argparse.Namespace) -> int:
-    import tomllib
-
-    fixed: dict[str, Any] = {}
-    for item in args.set or []:
-        k, _, v = item.partition("=")
-        try:
-            fixed[k.strip()] = tomllib.loads(f"v = {v}")["v"]
-        except tomllib.TOMLDecodeError:
-            fixed[k.strip()] = v
+    fixed = dict(parse_assignment(item) for item in args.set or [])
     lo, hi, n = args.pga
     levels = np.linspace(float(lo), float(hi), int(n))
     df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,

@@ -111,10 +111,43 @@ def test_errored_runs_are_reported_apart_and_stay_out_of_the_fit(tmp_path):
 
 
 def test_all_runs_errored_gives_a_clear_error(tmp_path):
-    with pytest.raises(ValueError, match=r"none of the 2 IDA runs completed.*2 errored.*first error: .*broken\.csv"):
+    # Every run starts and errors in the engine (a timestep far too short for the step limit).
+    with pytest.raises(ValueError, match=r"none of the 4 IDA runs completed.*4 errored.*first error: .*max_steps"):
+        run_ida("free-rocking", _pulses(tmp_path), [0.2, 0.5], tmp_path / "ida", fixed={**FIXED, "run.dt": 1e-9},
+                duration=2.0, executor="serial", progress=False)
+    assert (tmp_path / "ida" / "table.csv").exists()  # the table with the errors is kept for inspection
+
+
+def test_an_ida_none_of_whose_runs_can_start_is_refused_before_running(tmp_path):
+    """A bad ``fixed`` value, or records none of which can be read, is refused before any run
+    starts, nothing written; one unreadable record among good ones errors only its own runs
+    (test_errored_runs_are_reported_apart_and_stay_out_of_the_fit)."""
+    with pytest.raises(ValueError, match=r"no run of the IDA can start \(none of its 2 records.*\[damping\] beta.*'abc'"):
+        run_ida("free-rocking", _pulses(tmp_path), [0.2, 0.5], tmp_path / "ida", fixed={**FIXED, "damping.beta": "abc"},
+                duration=0.5, executor="serial", progress=False)
+    with pytest.raises(ValueError, match=r"no run of the IDA can start \(its record.*broken\.csv"):
         run_ida("free-rocking", [_unreadable(tmp_path)], [0.2, 0.5], tmp_path / "ida", fixed=FIXED, duration=0.5,
                 executor="serial", progress=False)
-    assert (tmp_path / "ida" / "table.csv").exists()  # the table with the errors is kept for inspection
+    for records, levels in (([], [0.2]), (_pulses(tmp_path), []), ("pulse1.csv", [0.2])):
+        with pytest.raises(ValueError, match="at least one record and one PGA level"):
+            run_ida("free-rocking", records, levels, tmp_path / "ida", fixed=FIXED, executor="serial", progress=False)
+    assert not (tmp_path / "ida").exists()
+
+
+@pytest.mark.parametrize("command", ["fragility", "calibrate"])
+def test_study_cli_refuses_a_bad_override_before_running(tmp_path, capsys, command):
+    from rockdem.cli import main
+
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time,rotation\n" + "\n".join(f"{0.01 * i},{0.001 * i}" for i in range(11)) + "\n")
+    head = (["fragility", *_pulses(tmp_path), "--pga", "0.1", "0.2", "2"] if command == "fragility"
+            else ["calibrate", str(ref), "--bounds", "0.001", "0.01"])
+    for item, said in (("damping.beta", "use table.key=value"), ("=5", "use table.key=value"),
+                       ("specimen.kn=abc", "kn must be a finite number"), ("damping.bogus=1", "unknown key(s) ['bogus']")):
+        out = tmp_path / f"out_{command}"
+        assert main([*head, "--duration", "0.5", "--executor", "serial", "--no-progress", "--out", str(out), "--set", item]) == 2
+        assert said in capsys.readouterr().err
+        assert not out.exists()
 
 
 def test_a_run_stopped_because_it_collapsed_is_a_failure():
