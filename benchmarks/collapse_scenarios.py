@@ -2,7 +2,8 @@
 
 Each builder returns a :class:`Scenario` (model, duration, record interval); ``short=True`` gives
 the quick version run by the tests, the default the full version run by
-``python benchmarks/bench_collapse.py``. :func:`evaluate` runs one and measures what issue-level
+``python benchmarks/collapse_scenarios.py`` (``--short``: the quick versions; ``--variants``: the
+same families on other records, geometries and seeds, :data:`VARIANTS`). :func:`evaluate` runs one and measures what issue-level
 acceptance needs: runtime, divergence, the largest interpenetration between two blocks computed
 independently of the engine (:mod:`rockdem.diagnostics`), and the largest energy creation
 max(KE + PE - initial - work) as a fraction of the run's energy scale.
@@ -13,7 +14,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -81,17 +82,19 @@ def _lowest_brick(model: Model, ds: xr.Dataset, bricks: list[str]) -> float:
     return min(_lowest_z(model, ds, n) for n in bricks if n not in fell)
 
 
-def edge_on_wall(short: bool = False) -> Scenario:
-    """A 0.3 m cube turned 45 deg about z and 45 deg about y, dropped from 20 mm with its lowest edge
-    across the top of a free 0.1 m thick wall; it lands on the edge, tips and falls."""
+def edge_on_wall(short: bool = False, *, yaw: float = 45.0, pitch: float = 45.0, wall: float = 0.1, cube_size: float = 0.3,
+                 drop: float = 0.02, offset: float = 0.01) -> Scenario:
+    """A ``cube_size`` cube turned ``yaw`` deg about z and ``pitch`` deg about y (default 0.3 m, 45
+    and 45), dropped from ``drop`` [m] with its lowest vertex ``offset`` [m] off the middle of a free
+    ``wall`` thick wall (0.6 m high): it lands on an edge or corner across the wall top, tips and falls."""
     b = ModelBuilder(points=(2, 2))
     b.default_material = _mat()
     add_foundation(b, 3.0)
-    b.add_box(0.1, 1.0, 0.6, density=2000, name="wall")
-    cube = box(0.3, 0.3, 0.3, name="cube")
-    r = axis_angle_matrix(np.array([0, 0, 1.0]), math.radians(45)) @ axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(45))
+    b.add_box(wall, 1.0, 0.6, density=2000, name="wall")
+    cube = box(cube_size, cube_size, cube_size, name="cube")
+    r = axis_angle_matrix(np.array([0, 0, 1.0]), math.radians(yaw)) @ axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(pitch))
     cube = cube.transformed(r, np.zeros(3))
-    cube = cube.transformed(np.eye(3), [0.01, 0.0, 0.6 + 0.02 - cube.vertices[:, 2].min()])
+    cube = cube.transformed(np.eye(3), [offset, 0.0, 0.6 + drop - cube.vertices[:, 2].min()])
     b.add_block(cube, density=2000, name="cube")
     return Scenario("edge_on_wall", b.finalize(), 0.35 if short else 1.5, 0.002,
                     "edge landing across a thin wall top (non-conformal, smaller face)")
@@ -118,20 +121,21 @@ PILE_KN = 1.8e9 / 0.2
 E = 1800 MPa and l = 0.2 m, the boxes' mean size."""
 
 
-def random_pile(short: bool = False, *, count: int = 40, seed: int = 7, kn: float = PILE_KN, name: str = "random_pile") -> Scenario:
-    """``count`` boxes of random sizes (0.08-0.3 m) and orientations dropped onto the ground from a
-    loose column; MP + SP damping brings the pile to rest. ``kn`` [Pa/m]: the joints' normal
-    stiffness (``random_pile_soft``: 2 GPa/m, 4.5 times softer; an impact's overlap grows as
+def random_pile(short: bool = False, *, count: int = 40, seed: int = 7, kn: float = PILE_KN, name: str = "random_pile",
+                sizes: tuple[float, float] = (0.08, 0.3), friction: float = 30.0, spacing: float = 0.45) -> Scenario:
+    """``count`` boxes of random sizes (``sizes``: 0.08-0.3 m) and orientations dropped onto the
+    ground from a loose column, nine per layer, ``spacing`` [m] apart (it must exceed the largest
+    box's diagonal for boxes that are turned); MP + SP damping brings the pile to rest. ``kn`` [Pa/m]: the joints'
+    normal stiffness (``random_pile_soft``: 2 GPa/m, 4.5 times softer; an impact's overlap grows as
     v sqrt(m / (kn A)), docs/contacts.md section 5)."""
     n = 12 if short else count
     rng = np.random.default_rng(seed)
     b = ModelBuilder(points=(2, 2))
-    b.default_material = _mat(kn=kn, friction=30.0)
+    b.default_material = _mat(kn=kn, friction=friction)
     add_foundation(b, 4.0)
-    spacing = 0.45
     per_layer = 9
     for k in range(n):
-        dims = rng.uniform(0.08, 0.3, size=3)
+        dims = rng.uniform(*sizes, size=3)
         q = rng.normal(size=4)
         q /= np.linalg.norm(q)
         from rockdem.kernels.rotation import quats_to_matrices
@@ -142,18 +146,24 @@ def random_pile(short: bool = False, *, count: int = 40, seed: int = 7, kn: floa
         poly = box(*dims, name=f"box{k}").transformed(r, [cx, cy, 0.3 + layer * spacing])
         b.add_block(poly, density=2000, name=f"box{k}")
     return Scenario(name, b.finalize(damping=Damping(alpha=2.0, beta=2e-4)), 2.0 if short else 4.0, 0.005,
-                    f"{n} random boxes dropped on the ground")
+                    f"{n} random boxes ({sizes[0]:g}-{sizes[1]:g} m, seed {seed}) dropped on the ground")
 
 
-def parapet_earthquake(short: bool = False, *, scale: float = 3.0, weak: bool = True) -> Scenario:
-    """A brick parapet 0.23 x 1.2 x 1.0 m (running bond, 0.2 x 0.083 m bricks) under El Centro x
-    ``scale``: weak joints (c = ft = 0.1 MPa) or strong joints on an unbonded base."""
+def parapet_earthquake(short: bool = False, *, scale: float = 3.0, weak: bool = True, record: str = ELCENTRO,
+                       thickness: float = 0.23, height: float = 1.0, length: float = 1.2,
+                       brick: tuple[float, float] = (0.2, 1.0 / 12), kn: float = 1.8e9 / 0.0833, friction: float = 31.0,
+                       strength: tuple[float, float] = (1e5, 1e6), extent: float = 12.0) -> Scenario:
+    """A brick parapet ``thickness`` x ``length`` x ``height`` (default 0.23 x 1.2 x 1.0 m, running
+    bond, 0.2 x 0.083 m bricks) under ``record`` (El Centro) x ``scale``, undamped: weak joints
+    (c = ft = ``strength[0]``, 0.1 MPa) or strong joints (``strength[1]``, 1 MPa) on an unbonded
+    base; a foundation ``extent`` [m] wide."""
     b = ModelBuilder()
-    joint = JointMaterial(kn=1.8e9 / 0.0833, friction_angle=31.0, cohesion=1e5 if weak else 1e6, tension=1e5 if weak else 1e6)
-    base = joint if weak else JointMaterial(kn=1.8e9 / 0.0833, friction_angle=31.0)
-    parapet(b, thickness=0.23, height=1.0, length=1.2, brick=(0.2, 1.0 / 12), material=joint, base_material=base, base_reduction=0.0,
-            foundation_extent=12.0)  # the ground around the building: bricks thrown off land on it
-    gm = read_record(resolve_record(ELCENTRO))
+    c = strength[0] if weak else strength[1]
+    joint = JointMaterial(kn=kn, friction_angle=friction, cohesion=c, tension=c)
+    base = joint if weak else JointMaterial(kn=kn, friction_angle=friction)
+    parapet(b, thickness=thickness, height=height, length=length, brick=brick, material=joint, base_material=base,
+            base_reduction=0.0, foundation_extent=extent)  # the ground around the building: bricks thrown off land on it
+    gm = read_record(resolve_record(record))
     dur = 3.0 if short else 8.0
     apply_earthquake(b, gm, scale=scale, window=(0.0, dur), baseline=True)
     model = b.finalize()
@@ -163,24 +173,28 @@ def parapet_earthquake(short: bool = False, *, scale: float = 3.0, weak: bool = 
                     {"lowest brick z [m]": lambda ds: _lowest_brick(model, ds, bricks)})
 
 
-def cascade_wall(short: bool = False) -> Scenario:
-    """The weakly bonded 0.19 x 2 m discretised wall of the Table 1 / Fig. 8 studies
-    (c = ft = 0.1 MPa, kn = 1e10 Pa/m), free rocking without damping."""
+def cascade_wall(short: bool = False, *, width: float = 0.19, height: float = 2.0, kn: float = 1e10,
+                 strength: float = 1e5, friction: float = 16.7) -> Scenario:
+    """The weakly bonded ``width`` x ``height`` discretised wall of the Table 1 / Fig. 8 studies
+    (default 0.19 x 2 m, c = ft = ``strength`` 0.1 MPa, kn = 1e10 Pa/m), free rocking without
+    damping."""
     from rockdem.reproduce.table1 import wall_case
 
-    data = wall_case(0.19, 2.0, 1e10, joint={"cohesion": 1e5, "tension": 1e5, "friction_angle_deg": 16.7})
+    data = wall_case(width, height, kn, joint={"cohesion": strength, "tension": strength, "friction_angle_deg": friction})
     data["run"]["duration"] = 3.0 if short else 6.0
     case = parse_case(data)
     return Scenario("cascade_wall", case.model, case.run.duration, 0.005, "bond-failure cascade at the impacts")
 
 
-def drum_column(short: bool = False, *, scale: float = 2.0) -> Scenario:
-    """Four 0.4 x 0.4 x 0.5 m drums (2 x 2 points, mu = 0.7) under El Centro x ``scale``."""
-    b = ModelBuilder(points=(2, 2))
-    mat = JointMaterial.from_modulus(1.8e9, 0.5, friction_angle=35.0)
+def drum_column(short: bool = False, *, scale: float = 2.0, record: str = ELCENTRO, count: int = 4, width: float = 0.4,
+                drum: float = 0.5, points: tuple[int, int] = (2, 2), modulus: float = 1.8e9, friction: float = 35.0) -> Scenario:
+    """``count`` drums ``width`` x ``width`` x ``drum`` (default four 0.4 x 0.4 x 0.5 m, 2 x 2
+    points, mu = 0.7, kn = E / drum) under ``record`` (El Centro) x ``scale``."""
+    b = ModelBuilder(points=points)
+    mat = JointMaterial.from_modulus(modulus, drum, friction_angle=friction)
     b.default_material = mat
-    stacked_blocks(b, width=0.4, length=0.4, heights=[0.5] * 4, density=2400, material=mat)
-    gm = read_record(resolve_record(ELCENTRO))
+    stacked_blocks(b, width=width, length=width, heights=[drum] * count, density=2400, material=mat)
+    gm = read_record(resolve_record(record))
     dur = 4.0 if short else 12.0
     apply_earthquake(b, gm, scale=scale, window=(0.0, dur), baseline=True)
     return Scenario(f"drum_column_x{scale:g}", b.finalize(), dur, 0.005, "drums sliding and rocking on each other")
@@ -280,6 +294,42 @@ SCENARIOS: dict[str, Callable[..., Scenario]] = {
 }
 
 
+
+def _named(build: Callable[[], Scenario], name: str) -> Callable[..., Scenario]:
+    """``build`` (full length only) under another name."""
+    return lambda short=False: replace(build(), name=name)
+
+
+STURNO, PACOIMA, BAGNOLI, NAHANNI = ("RSN292_ITALY_A-STU270.AT2", "RSN77_SFERN_PUL164.AT2", "RSN285_ITALY_A-BAG270.AT2",
+                                     "Nahanni_1985_NS1-280.csv")
+VARIANTS: dict[str, Callable[..., Scenario]] = {
+    # The same families on other records, geometries, materials and seeds (issue 11: "the same
+    # families will be run on unseen geometries and records"); full length only, about 35 min.
+    "edge_on_wall_30": _named(lambda: edge_on_wall(yaw=30.0, pitch=40.0, wall=0.12, drop=0.05, offset=-0.02), "edge_on_wall_30"),
+    "edge_on_wall_corner": _named(lambda: edge_on_wall(yaw=60.0, pitch=35.0, wall=0.08, cube_size=0.25, drop=0.1), "edge_on_wall_corner"),
+    "random_pile_45": _named(lambda: random_pile(count=45, seed=11, friction=25.0), "random_pile_45"),
+    "random_pile_50_wide": _named(lambda: random_pile(count=50, seed=12, sizes=(0.05, 0.4), spacing=0.7), "random_pile_50_wide"),
+    "parapet_sturno_x3_weak": _named(lambda: parapet_earthquake(scale=3.0, weak=True, record=STURNO, thickness=0.35, height=1.5,
+                                                                length=1.8, brick=(0.25, 0.075), kn=1.8e9 / 0.075, friction=33.0,
+                                                                strength=(5e4, 8e5), extent=14.0), "parapet_sturno_x3_weak"),
+    "parapet_pacoima_x2_strong": _named(lambda: parapet_earthquake(scale=2.0, weak=False, record=PACOIMA, thickness=0.35,
+                                                                   height=1.5, length=1.8, brick=(0.25, 0.075), kn=1.8e9 / 0.075,
+                                                                   friction=33.0, strength=(5e4, 8e5), extent=14.0),
+                                        "parapet_pacoima_x2_strong"),
+    "parapet_bagnoli_x5_weak": _named(lambda: parapet_earthquake(scale=5.0, weak=True, record=BAGNOLI, thickness=0.35, height=1.5,
+                                                                 length=1.8, brick=(0.25, 0.075), kn=1.8e9 / 0.075, friction=33.0,
+                                                                 strength=(5e4, 8e5), extent=14.0), "parapet_bagnoli_x5_weak"),
+    "cascade_wall_squat": _named(lambda: cascade_wall(width=0.25, height=1.5, kn=8e9, strength=5e4, friction=20.0), "cascade_wall_squat"),
+    "cascade_wall_slender": _named(lambda: cascade_wall(width=0.15, height=2.5, kn=8e9, strength=2e4, friction=20.0),
+                                   "cascade_wall_slender"),
+    "drum_column_sturno_x3": _named(lambda: drum_column(scale=3.0, record=STURNO, count=3, width=0.3, drum=0.6, points=(3, 3),
+                                                        modulus=2.4e9, friction=38.0), "drum_column_sturno_x3"),
+    "drum_column_nahanni_x2": _named(lambda: drum_column(scale=2.0, record=NAHANNI, count=5, width=0.35, drum=0.45, points=(3, 3),
+                                                         modulus=2.4e9, friction=38.0), "drum_column_nahanni_x2"),
+}
+"""Unseen variants of the scenarios (``python benchmarks/collapse_scenarios.py --variants``)."""
+
+
 @dataclass
 class Outcome:
     """Measured figures of one scenario run."""
@@ -341,12 +391,15 @@ def evaluate(sc: Scenario, *, overlap_every: int = 1, dashpots: str | None = Non
     return out, ds
 
 
-def run_all(names: list[str] | None = None, *, short: bool = False, dashpots: str | None = None) -> list[Outcome]:
-    """Run the named scenarios (default all) and print one line each."""
+def run_all(names: list[str] | None = None, *, short: bool = False, dashpots: str | None = None,
+            variants: bool = False) -> list[Outcome]:
+    """Run the named scenarios (default all; ``variants``: those of :data:`VARIANTS`) and print one
+    line each."""
+    table = VARIANTS if variants else SCENARIOS
     outs = []
-    for name in names or list(SCENARIOS):
+    for name in names or list(table):
         try:
-            sc = SCENARIOS[name](short=short)
+            sc = table[name](short=short)
             out, _ = evaluate(sc, overlap_every=1 if short else 2, dashpots=dashpots)
         except Exception as exc:  # a scenario that cannot run is reported, not fatal
             print(f"{name:20s} FAILED: {type(exc).__name__}: {exc}", flush=True)
@@ -365,4 +418,5 @@ if __name__ == "__main__":  # pragma: no cover
 
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     _print_header()
-    run_all(args or None, short="--short" in sys.argv, dashpots="explicit" if "--explicit" in sys.argv else None)
+    run_all(args or None, short="--short" in sys.argv, dashpots="explicit" if "--explicit" in sys.argv else None,
+            variants="--variants" in sys.argv)
