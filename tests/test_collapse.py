@@ -217,19 +217,30 @@ def test_fast_block_landing_is_tracked_before_it_presses():
     assert out.balance_error < 0.01, f"energy balance off by {100 * out.balance_error:.3g} %"
 
 
-def test_loaded_contact_changing_representation_keeps_its_energy():
+@pytest.mark.parametrize("perturbation", [{}, {"offset": 0.0099}, {"pitch": 45.01}, {"drop": 0.0201}])
+def test_loaded_contact_changing_representation_keeps_its_energy(perturbation):
     """The cube landing edge-first across a thin wall top (the full 1.5 s run) tips over the wall's
     edge: at 0.824 s its three partly covered face sub-contacts (10.3 J) became one edge-edge
     contact 0.57 mm deep whose spring held 21.8 J from its geometry, and at 1.322 s an edge pair
     turning face to face vanished with its 2.9 J unbooked: the balance was off by 3.7 % of the
-    energy scale. A contact that changes representation now hands its spring energy over (the new
-    edge spring starts with no more than it replaces) and what it drops is booked."""
-    sc = scenarios.edge_on_wall()
+    energy scale, for good. A contact that changes representation now hands its spring energy over
+    (the new edge spring starts with no more than it replaces) and what it drops is booked.
+
+    Which way the cube tips, and when it hits the ground, is chaotic: the same code takes another
+    path on another CPU (the unperturbed run ended more than 0.1 m below its start on the machine
+    of 2026-11-26; on an AMD EPYC it hit the ground at 3 m/s and was mid-bounce at the end, 0.09 m
+    below). So the run is checked on slightly perturbed inputs too, for what holds on every path:
+    the cube goes over the edge (its centre comes below the wall's top), no energy is created at
+    any frame, and what was lost is booked by the end. The balance is taken after the impacts, not during one: a frame in the middle of the
+    cube's 3 m/s corner impact on the ground shows the leapfrog's staggered energies (-0.64 % of
+    the scale at one frame, -0.07 % 2 ms later, measured on an AMD EPYC)."""
+    sc = scenarios.edge_on_wall(**perturbation)
     out, ds = scenarios.evaluate(sc)
     assert not out.diverged
     z = ds.block_position.values[:, sc.model.block_id("cube"), 2]
-    assert z[-1] < z[0] - 0.1  # it tipped over the wall's edge
-    assert out.balance_error < 0.005, f"energy balance off by {100 * out.balance_error:.3g} %"
+    assert z.min() < 0.6  # it went over the wall's edge: its centre came below the wall's top
+    final = float(ds.energy_balance_error_relative.values[-1])
+    assert abs(final) < 0.005, f"energy balance off by {100 * final:.3g} % at the end"
     assert out.energy_created <= 0.001 * out.energy_scale
     assert out.overlap_relative < 0.02
 
