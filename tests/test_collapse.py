@@ -231,9 +231,10 @@ def test_loaded_contact_changing_representation_keeps_its_energy(perturbation):
     of 2026-11-26; on an AMD EPYC it hit the ground at 3 m/s and was mid-bounce at the end, 0.09 m
     below). So the run is checked on slightly perturbed inputs too, for what holds on every path:
     the cube goes over the edge (its centre comes below the wall's top), no energy is created at
-    any frame, and what was lost is booked by the end. The balance is taken after the impacts, not during one: a frame in the middle of the
-    cube's 3 m/s corner impact on the ground shows the leapfrog's staggered energies (-0.64 % of
-    the scale at one frame, -0.07 % 2 ms later, measured on an AMD EPYC)."""
+    any frame, and what was lost is booked by the end. The balance is taken after the impacts, not
+    during one: a frame in the middle of the cube's 3 m/s corner impact on the ground shows the
+    leapfrog's staggered energies (-0.64 % of the scale at one frame, -0.07 % 2 ms later, measured
+    on an AMD EPYC)."""
     sc = scenarios.edge_on_wall(**perturbation)
     out, ds = scenarios.evaluate(sc)
     assert not out.diverged
