@@ -112,7 +112,8 @@ def prepare_record(
     window: tuple[float, float] | None = None,
 ) -> GroundMotion:
     """Process a record for application: window, scale (or scale to ``pga`` [m/s^2]), direction,
-    baseline correction (linear velocity trend removed) and a free-vibration tail [s].
+    baseline correction (linear velocity trend removed, the ground brought to rest at the end:
+    :meth:`rockdem.records.GroundMotion.baseline_corrected`) and a free-vibration tail [s].
 
     The windowed record restarts from rest at the window start. At least one zero-acceleration
     sample is appended so that the held end value of the input tables is "no acceleration".
@@ -171,7 +172,8 @@ def apply_earthquake(
         pga: scale the record to this horizontal PGA [m/s^2] instead.
         direction: horizontal direction (3,) of the record; default the record's own (+x).
         vertical: apply the record's vertical component too (it must have one).
-        baseline: remove the linear trend of the ground velocity (foundation ends near rest).
+        baseline: remove the linear trend of the ground velocity and bring the foundation to rest
+            at the end (:meth:`rockdem.records.GroundMotion.baseline_corrected`).
         tail: free-vibration time after the record [s].
         window: (start, end) part of the record to use [s of the record]; restarts from rest.
         delay: time at rest before the record starts [s] (lets the model settle under gravity).

@@ -285,14 +285,21 @@ class GroundMotion:
         return replace(self, direction=np.asarray(direction, dtype=float))
 
     def baseline_corrected(self, order: int = 1) -> GroundMotion:
-        """Return the record with a polynomial velocity baseline removed.
+        """Return the record with a polynomial velocity baseline removed, ending at rest.
 
         The velocity v(t) (trapezoid integral of a, v(t0) = 0) is fitted in the least-squares sense by
         a polynomial p(t) of degree ``order`` (constant term included), and the acceleration becomes
         a(t) - p'(t) at every sample. For ``order`` <= 2, p' is at most linear, which the trapezoid rule
         integrates exactly, so the corrected velocity is exactly v(t) - p(t) + p(t0): its least-squares
-        trend is gone and it ends near zero. ``order=1`` removes a constant acceleration offset.
-        The vertical component, if any, is corrected the same way, separately.
+        trend is gone. ``order=1`` removes a constant acceleration offset.
+
+        The velocity still left at the end (a record cut inside its strong motion, ``window`` of
+        :func:`rockdem.loading.prepare_record`) is then taken out smoothly over the last tenth of the
+        record (at least two samples): a deceleration V r'(t), r = sin^2 rising from 0 to 1, sized so
+        that the record followed by zero acceleration (:meth:`with_tail`) ends exactly at rest (a
+        trapezoid integral). The record before that last tenth is unchanged, a permanent ground
+        displacement (a velocity pulse) is kept. The vertical component, if any, is corrected the
+        same way, separately.
 
         Args:
             order: degree of the velocity polynomial, 1 <= order < npts.
@@ -303,11 +310,16 @@ class GroundMotion:
         # Fit on t - t0 scaled to [0, 1] to keep the polynomial basis well conditioned.
         span = max(self.duration, self.dt)
         s = (self.time - self.start_time) / span
+        ramp = max(0.1 * span, 2.0 * self.dt)  # [s]
+        x = np.clip((self.time - (self.time[-1] - ramp)) / ramp, 0.0, 1.0)
+        stop = np.append(np.pi / (2.0 * ramp) * np.sin(np.pi * x), 0.0)  # r'(t) [1/s], then a zero sample
 
         def corrected(acc: NDArray[np.float64]) -> NDArray[np.float64]:
             vel = _integral(acc, self.dt)
             fit = np.polynomial.Polynomial.fit(s, vel, int(order), domain=[0.0, 1.0], window=[0.0, 1.0])
-            return acc - fit.deriv()(s) / span
+            acc = acc - fit.deriv()(s) / span
+            left = _integral(np.append(acc, 0.0), self.dt)[-1]  # [m/s] after the record, at rest after
+            return acc - left / _integral(stop, self.dt)[-1] * stop[:-1]
 
         vertical = None if self.vertical is None else corrected(self.vertical)
         return replace(self, acceleration=corrected(self.acceleration), vertical=vertical)

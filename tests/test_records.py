@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rockdem.loading import prepare_record
 from rockdem.records import (
     DATA_ENV,
     SHIPPED_RECORDS,
@@ -359,6 +360,29 @@ def test_baseline_correction_removes_offset() -> None:
     # A pure constant offset is removed exactly (a linear velocity is fitted exactly): roundoff only.
     flat = GroundMotion(np.full(500, a0), dt).baseline_corrected(order=2)
     assert np.max(np.abs(flat.acceleration)) <= 1e-12
+
+
+@pytest.mark.parametrize("window", [(0.0, 20.0), (3.0, 7.31), (10.0, 40.0)])
+def test_windowed_record_ends_at_rest(window) -> None:
+    """A shipped record cut inside its strong motion (El Centro at 20 s moves at 0.068 m/s) is
+    brought to rest over the last tenth of the window and stays at rest through the tail; before
+    that tenth the correction is the linear trend removal alone (a constant), and over a long
+    window the deceleration is small against the record. (Before 2026-11-27 the ground kept the velocity left at the cut: El Centro
+    cut at 20 s drifted at 0.061 m/s through the whole tail, 3 m in 50 s.)"""
+    gm = read_record("elcentro-rsn6")
+    raw = prepare_record(gm, window=window, baseline=False)  # with one zero sample appended
+    applied = prepare_record(gm, window=window, tail=50.0)
+    n = raw.npts - 1
+    t, duration = raw.time[:n], raw.duration - raw.dt
+    speed = np.max(np.abs(applied.velocity()))
+    assert np.max(np.abs(applied.velocity()[n:])) <= 1e-12 * speed
+    shift = np.ptp(applied.displacement()[n:])
+    assert shift <= 1e-10 * np.max(np.abs(applied.displacement()))
+    head = t < t[-1] - 0.1 * duration
+    change = applied.acceleration[:n] - raw.acceleration[:n]
+    assert np.all(np.diff(change[head]) == pytest.approx(0.0, abs=1e-12))  # a constant offset there
+    if duration >= 20.0:  # a long window: the deceleration is small against the record
+        assert np.max(np.abs(change)) <= 0.03 * gm.pga
 
 
 def test_direction_vertical_and_resampling() -> None:
