@@ -44,6 +44,8 @@ __all__ = [
     "lowest_vertex_height",
     "result_eta",
     "eta_of",
+    "is_free_rocking",
+    "is_pushover",
     "summarize_result",
 ]
 
@@ -475,6 +477,7 @@ def summarize(
     z: ArrayLike | None = None,
     z_rest: float | None = None,
     bounce_tol: float | None = None,
+    free_rocking: bool = True,
 ) -> dict[str, Any]:
     """Summary of one rotation history (keys carry their unit).
 
@@ -487,6 +490,9 @@ def summarize(
         z: (n,) height of the block's lowest point [m], enables the bouncing entries.
         z_rest: ground level for ``z`` [m] (default z[0]).
         bounce_tol: airborne threshold [m] (default that of :func:`bouncing`).
+        free_rocking: the history is free rocking from a release (False: under a ground motion or
+            a pushover); e_a (Eq. 6) measures only the decay of free rocking and is left out
+            otherwise.
 
     Returns:
         dict of scalars; absent measurements are omitted, a never-reached onset is None.
@@ -507,7 +513,7 @@ def summarize(
         out["exceeded_eta"] = bool(max_rotation(th) > eta)
         out["overturned"] = overturned(th, eta)
         th0 = abs(float(pk.value[0])) if len(pk.value) else 0.0
-        if len(pk.value) >= 2 and 0.0 < th0 < eta:
+        if free_rocking and len(pk.value) >= 2 and 0.0 < th0 < eta:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ea = apparent_restitution(pk.value[1:], th0, eta)
@@ -569,6 +575,22 @@ def eta_of(attrs: Mapping[str, Any], block_eta: ArrayLike | None, block: int) ->
     return None
 
 
+def is_pushover(ds: Any) -> bool:
+    """Whether a result is a pushover (a ``load_factor`` variable or the ``pushover_*`` attributes
+    that :func:`rockdem.loading.pushover` and the TOML pushover loadings write)."""
+    return "load_factor" in ds or any(str(k).startswith("pushover_") for k in ds.attrs)
+
+
+def is_free_rocking(ds: Any) -> bool:
+    """Whether a result is a free-rocking run: released from a tilt (attrs ``tilt_angle_rad`` or a
+    non-zero rocking angle at t = 0), with no earthquake and no pushover."""
+    moved = "ground_displacement" in ds and bool(np.any(ds.ground_displacement.values != 0.0))
+    if is_pushover(ds) or "earthquake_mode" in ds.attrs or moved:
+        return False
+    free = np.flatnonzero(ds.block_free.values)
+    return "tilt_angle_rad" in ds.attrs or bool(np.any(ds.rocking_angle.values[0, free] != 0.0))
+
+
 def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = None) -> dict[str, Any]:
     """:func:`summarize` for one block of a rockdem result (``xarray.Dataset``).
 
@@ -599,4 +621,4 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
     t = np.asarray(ds["time"].values, dtype=float)
     theta = np.asarray(ds["rocking_angle"].values[:, block], dtype=float)
     z = lowest_point_height(ds, block)
-    return summarize(t, theta, eta=eta, z=z)
+    return summarize(t, theta, eta=eta, z=z, free_rocking=is_free_rocking(ds))

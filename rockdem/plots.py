@@ -29,7 +29,16 @@ import xarray as xr
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 
-from .analysis import apparent_restitution, bouncing, half_cycle_peaks, lowest_point_height, result_eta, wme
+from .analysis import (
+    apparent_restitution,
+    bouncing,
+    half_cycle_peaks,
+    is_free_rocking,
+    is_pushover,
+    lowest_point_height,
+    result_eta,
+    wme,
+)
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices
 
 __all__ = [
@@ -414,12 +423,6 @@ def plot_energy(result: Result) -> Figure:
     return fig
 
 
-def is_pushover(ds: xr.Dataset) -> bool:
-    """Whether a result is a pushover (a ``load_factor`` variable or the ``pushover_*`` attributes
-    that :func:`rockdem.loading.pushover` and the TOML pushover loadings write)."""
-    return "load_factor" in ds or any(str(k).startswith("pushover_") for k in ds.attrs)
-
-
 def _capacity_force(ds: xr.Dataset, monitor: str | None) -> tuple[np.ndarray, str]:
     """Load factor (T,) [-] of a pushover and its axis label."""
     if "load_factor" in ds:
@@ -610,15 +613,6 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: float | None = None) -> P
 
 
 # -- CLI ----------------------------------------------------------------------------------------
-def is_free_rocking(ds: xr.Dataset) -> bool:
-    """Whether a result is a free-rocking run: released from a tilt (attrs ``tilt_angle_rad`` or a
-    non-zero rocking angle at t = 0), with no earthquake and no pushover."""
-    if is_pushover(ds) or "earthquake_mode" in ds.attrs or np.any(ground_displacement(ds) != 0.0):
-        return False
-    free = np.flatnonzero(ds.block_free.values)
-    return "tilt_angle_rad" in ds.attrs or bool(np.any(ds.rocking_angle.values[0, free] != 0.0))
-
-
 def _not_applicable(kind: str, items: Sequence[xr.Dataset], measured: object) -> str:
     """Why a plot kind does not apply to these results ("" when it does)."""
     first = items[0]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import signal
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -17,7 +18,7 @@ from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, positive_int, stop_on_signals
 from .results import export_csv, save, write_contact_table
-from .simulation import simulate
+from .simulation import _deferred_signals, simulate
 from .stopping import STOP_MODES
 
 __all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
@@ -41,11 +42,12 @@ def run_case(
     """
     ds = simulate(case.model, **run_options(case, duration), progress=progress, initial=initial, checkpoint=checkpoint,
                   checkpoint_every=checkpoint_every, threads=threads)
-    ds.attrs.update(case.attrs)
-    t = ds.time.values
-    for name, (ts, values) in case.series.items():
-        v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])
-        ds[name] = (("time", "xyz"), v, {"units": "m/s2" if "acceleration" in name else "1"})
+    with _deferred_signals(finishing=True):  # the frames are computed: a stop signal waits for the result
+        ds.attrs.update(case.attrs)
+        t = ds.time.values
+        for name, (ts, values) in case.series.items():
+            v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])
+            ds[name] = (("time", "xyz"), v, {"units": "m/s2" if "acceleration" in name else "1"})
     return ds
 
 
@@ -278,12 +280,15 @@ def _run(args: argparse.Namespace) -> int:
     print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
         print("  " + _row("wrote", "", "", str(p)))
-    if "checkpoint" in ds.attrs and (received or ds.attrs.get("interrupted")):
-        src = f"--example {args.example}" if args.example else str(args.case)
-        print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else "")
-              + (f" --stop {args.stop}" if args.stop else ""))
-    if received or ds.attrs.get("interrupted"):  # stopped, or interrupted while saving (the save went on)
+    if ds.attrs.get("interrupted"):  # stopped before the end: the frames computed so far are saved
+        if "checkpoint" in ds.attrs:
+            src = f"--example {args.example}" if args.example else str(args.case)
+            print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else "")
+                  + (f" --stop {args.stop}" if args.stop else ""))
         return 128 + (received[0] if received else signal.SIGINT)
+    if received:  # the signal came once every frame was computed: the result is complete and saved
+        print(f"rockdem run: {signal.Signals(received[0]).name} came after the run had ended; the result is complete",
+              file=sys.stderr)
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
 
 
@@ -296,8 +301,9 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
         "rocking.png and checkpoint.npz (contacts.csv with [run] contact_interval), and print a summary.",
         epilog="Exit status: 0 done; 2 bad input (nothing run); 3 the run diverged (the result holds the "
         "frames before it); 128+N stopped by signal N (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP): the frames "
-        "computed so far are saved. An interrupt while saving is held (the save goes on); a second one "
-        "abandons the save.",
+        "computed so far are saved. A signal once every frame is computed is held: the complete result is "
+        "saved, with the run's own exit status. An interrupt while saving is held (the save goes on); a "
+        "second one abandons the save.",
     )
     p.add_argument("case", nargs="?", help="TOML case file")
     p.add_argument("--example", help=f"built-in example ({', '.join(example_names())})")

@@ -152,8 +152,9 @@ def simulate(
                     dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
                     contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
                     checkpoint=checkpoint, checkpoint_every=checkpoint_every, threads=threads)
-    ds = build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs)
-    return out.snapshots.attach(ds)
+    with _deferred_signals(finishing=True):
+        ds = out.snapshots.attach(build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs))
+    return ds
 
 
 class Start(NamedTuple):
@@ -304,62 +305,65 @@ def run_model(
     finally:
         if bar is not None:
             bar.close()
-    if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
-        decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
-    runtime = _time.perf_counter() - wall0 + run.runtime_before
-    attrs: dict[str, Any] = {
-        "dt": info.dt,
-        "dt_min": float(state.dt_min[0]),
-        "dt_critical": info.critical,
-        "omega_max": info.omega_max,
-        "sp_factor": info.sp_factor,
-        "resolution": info.resolution,
-        "timestep_rule": info.rule,
-        "dashpots": info.dashpots,
-        "damping_ratio": info.damping_ratio,
-        "dashpot_sweeps": int(state.dashpot_sweeps[0]),
-        "dashpot_unconverged_steps": int(state.dashpot_unconverged[0]),
-        "steps": int(state.step[0]),
-        "sub_contact_updates": int(state.slot_updates[0]),
-        "threads": n_threads,
-        "runtime_s": runtime,
-        "kernel_s": kernel,
-        "duration": duration,
-        "record_interval": run.record_interval,
-        "interrupted": int(interrupted),
-        "stop_rule": rule.mode if rule is not None else "off",
-    }
-    if run.continued_from is not None:
-        attrs["continued_from_time"] = run.continued_from
-    if decision is not None:
-        attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
-    if status in (STATUS_DIVERGED, STATUS_LOST):
-        attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
-        warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
-        frame -= 1  # keep the sound frames before the bad one
-    elif sunk is not None:
-        t_now = float(state.time[0])
-        block, what = sunk
-        msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {what}; the result holds the frames computed"
-        attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
-                      "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
-        warnings.warn(msg, RuntimeWarning, stacklevel=2)
-    elif checkpoint is not None:  # every frame computed, also past a stop decision (see the module notes)
-        attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime, target))
-    if attrs.get("diverged") and checkpoint is not None:
-        attrs["checkpoint_note"] = "no checkpoint written: the run diverged"
-    fell = np.flatnonzero(state.fell_off >= 0.0)
-    if fell.size:
-        listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
-        attrs["fell_off_blocks"] = ", ".join(model.block_names[b] for b in fell)
-        attrs["fell_off_times"] = state.fell_off[fell].astype(float)
-        warnings.warn(
-            f"block(s) fell off the edge of the model's supports and fall on unhindered: {listed}; "
-            "a larger foundation (the specimen builders' foundation_extent) keeps them",
-            RuntimeWarning, stacklevel=2,
-        )
-    end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
-    return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
+    # Past the loop every frame is computed: a stop signal from here on is held until the result is
+    # put together, and the result is returned (see _deferred_signals).
+    with _deferred_signals(finishing=True):
+        if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
+            decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
+        runtime = _time.perf_counter() - wall0 + run.runtime_before
+        attrs: dict[str, Any] = {
+            "dt": info.dt,
+            "dt_min": float(state.dt_min[0]),
+            "dt_critical": info.critical,
+            "omega_max": info.omega_max,
+            "sp_factor": info.sp_factor,
+            "resolution": info.resolution,
+            "timestep_rule": info.rule,
+            "dashpots": info.dashpots,
+            "damping_ratio": info.damping_ratio,
+            "dashpot_sweeps": int(state.dashpot_sweeps[0]),
+            "dashpot_unconverged_steps": int(state.dashpot_unconverged[0]),
+            "steps": int(state.step[0]),
+            "sub_contact_updates": int(state.slot_updates[0]),
+            "threads": n_threads,
+            "runtime_s": runtime,
+            "kernel_s": kernel,
+            "duration": duration,
+            "record_interval": run.record_interval,
+            "interrupted": int(interrupted),
+            "stop_rule": rule.mode if rule is not None else "off",
+        }
+        if run.continued_from is not None:
+            attrs["continued_from_time"] = run.continued_from
+        if decision is not None:
+            attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
+        if status in (STATUS_DIVERGED, STATUS_LOST):
+            attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
+            warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
+            frame -= 1  # keep the sound frames before the bad one
+        elif sunk is not None:
+            t_now = float(state.time[0])
+            block, what = sunk
+            msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {what}; the result holds the frames computed"
+            attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
+                          "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
+            warnings.warn(msg, RuntimeWarning, stacklevel=2)
+        elif checkpoint is not None:  # every frame computed, also past a stop decision (see the module notes)
+            attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime, target))
+        if attrs.get("diverged") and checkpoint is not None:
+            attrs["checkpoint_note"] = "no checkpoint written: the run diverged"
+        fell = np.flatnonzero(state.fell_off >= 0.0)
+        if fell.size:
+            listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
+            attrs["fell_off_blocks"] = ", ".join(model.block_names[b] for b in fell)
+            attrs["fell_off_times"] = state.fell_off[fell].astype(float)
+            warnings.warn(
+                f"block(s) fell off the edge of the model's supports and fall on unhindered: {listed}; "
+                "a larger foundation (the specimen builders' foundation_extent) keeps them",
+                RuntimeWarning, stacklevel=2,
+            )
+        end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
+        return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
 
 
 @dataclass
@@ -493,10 +497,13 @@ class _Saver:
 
 
 @contextlib.contextmanager
-def _deferred_signals() -> Iterator[None]:
+def _deferred_signals(finishing: bool = False) -> Iterator[None]:
     """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
     deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
-    halfway through it. Outside the main thread (where no signal arrives) this does nothing."""
+    halfway through it. With ``finishing`` (the result of a run whose frames are all computed being
+    put together), the KeyboardInterrupt the handler raises is caught, so that the result is
+    returned; the handler has seen the signal (``rockdem run`` then notes it and exits once the
+    result is saved). Outside the main thread (where no signal arrives) this does nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -514,7 +521,11 @@ def _deferred_signals() -> Iterator[None]:
         for sig, handler in old.items():
             signal.signal(sig, handler)
         for signum, frame in held[:1]:
-            old[signum](signum, frame)
+            try:
+                old[signum](signum, frame)
+            except KeyboardInterrupt:
+                if not finishing:
+                    raise
 
 
 SINK_FRACTION = 0.25

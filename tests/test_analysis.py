@@ -224,6 +224,13 @@ def test_summarize_result_on_a_dataset() -> None:
     assert 0 < s["e_a_mean"] < 1
     s2 = summarize_result(_dataset(x, t, eta=None))
     assert "e_a_mean" not in s2 and "overturned" not in s2
+    # e_a (Eq. 6) is the decay of free rocking: not given for a run under a ground motion (the
+    # El Centro example printed e_a = 1.05, first 1.49) or a pushover
+    for forced in ({"earthquake_mode": "foundation"}, {"pushover_rate": 0.05}):
+        s3 = summarize_result(ds.assign_attrs(forced))
+        assert "e_a_mean" not in s3 and "e_a_first" not in s3 and s3["half_cycles"] == 6
+    moving = ds.assign(ground_displacement=(("time", "xyz"), np.outer(t, [0.01, 0.0, 0.0])))
+    assert "e_a_mean" not in summarize_result(moving)
     with pytest.raises(ValueError, match="rocking_angle"):
         summarize_result(ds.drop_vars("rocking_angle"))
     with pytest.raises(ValueError, match="out of range"):

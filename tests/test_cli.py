@@ -145,13 +145,15 @@ def test_stop_signals_save_the_frames_computed_so_far(tmp_path, capsys, monkeypa
 
 
 def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_path, capsys, monkeypatch):
+    """One interrupt while the complete result is saved is held: the save goes on and the run's own
+    exit status is kept (0: the result is whole). A second one abandons the save (130)."""
     import os
     import signal
 
     import rockdem.run_cli
 
     real = rockdem.run_cli.save
-    for count, code, saved in ((1, 130, True), (2, 130, False)):
+    for count, code, saved in ((1, 0, True), (2, 130, False)):
         out = tmp_path / str(count)
 
         def save(ds, path, count=count):
@@ -166,6 +168,38 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
         assert (out / "result.nc").exists() == saved
         if not saved:
             assert "stopped by SIGINT" in err
+        else:
+            assert "SIGINT came after the run had ended; the result is complete" in err
+
+
+@pytest.mark.parametrize("where", ["_Saver.save", "build_dataset"])
+def test_a_stop_signal_after_the_last_frame_keeps_the_whole_result(tmp_path, capsys, monkeypatch, where):
+    """A SIGTERM that comes once every frame is computed, while the result is put together (in
+    run_model past its loop: the final checkpoint; in simulate: the dataset) is held: the complete
+    result is saved and the run's status returned. It used to escape as 'stopped by SIGTERM', exit
+    143, with nothing but the checkpoint written."""
+    import os
+    import signal
+
+    import rockdem.simulation
+
+    owner = {"_Saver.save": rockdem.simulation._Saver, "build_dataset": rockdem.simulation}[where]
+    name = where.rsplit(".", 1)[-1]
+    real = getattr(owner, name)
+
+    def late(*args, **kwargs):
+        out = real(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGTERM)
+        return out
+
+    monkeypatch.setattr(owner, name, late)
+    args = ["run", "--example", "free-rocking", "--out", str(tmp_path), "--duration", "0.2", "--quiet", "--no-plot"]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "SIGTERM came after the run had ended; the result is complete" in err
+    ds = load(tmp_path / "result.nc")
+    assert ds.attrs["interrupted"] == 0 and float(ds.time[-1]) == pytest.approx(0.2)
+    assert (tmp_path / "histories.csv").exists()
 
 
 def test_only_the_program_pauses_and_freezes_the_garbage_collector(monkeypatch):
