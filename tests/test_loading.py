@@ -214,3 +214,22 @@ def test_loading_context_reaches_the_result():
     t = ds.time.values
     ag = ds.ground_acceleration.values[:, 0]
     assert np.allclose(ag[t < gm.time[-1]], scale * np.interp(t, gm.time, gm.acceleration)[t < gm.time[-1]], atol=0.02 * gm.pga)
+
+
+def test_a_block_riding_on_a_moving_foundation_is_not_lost():
+    """The model's extent moves with the driven blocks: a block carried 4.75 m by its foundation
+    (ramped to 1 m/s in 0.5 s, then steady: 0.2 g, below the friction and rocking thresholds of the
+    squat block) rides along, where it used to be reported to have left the extent (fixed at 3 m)."""
+    from rockdem.model import Motion
+
+    bld = ModelBuilder()
+    bld.default_material = JointMaterial.from_modulus(1e9, 0.25, friction_angle=35)
+    bld.add_box(2.0, 2.0, 0.5, base_center=(0.0, 0.0, -0.5), driven="ground", group="ground", name="ground")
+    bld.add_box(0.5, 0.5, 0.25, base_center=(0.0, 0.0, 0.0), density=2000, name="block")
+    bld.set_ground_motion(Motion(time=[0.0, 0.5, 10.0], velocity=[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]))
+    ds = simulate(bld.finalize(damping=Damping()), 5.0, record_interval=0.05, progress=False)
+    assert not ds.attrs.get("diverged"), ds.attrs.get("diverged_message")
+    x = ds.block_position.values[:, :, 0]
+    assert x[-1, 0] == pytest.approx(4.75, abs=1e-3)  # the foundation moved past the extent of the start
+    np.testing.assert_allclose(x[:, 1], x[:, 0], atol=1e-3)  # the block moved with it
+    np.testing.assert_allclose(ds.block_position.values[:, 1, 2], 0.125, atol=1e-4)

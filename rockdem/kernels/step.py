@@ -399,6 +399,20 @@ def integrate_positions(m: ModelArrays, s: State, dt: float) -> None:
         s.moved[b] += block_speed(m, s, b) * dt
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _driven_shift(m: ModelArrays, s: State, rec: Records, i: int) -> tuple[float, float]:
+    """(lowest, highest) displacement [m] along axis i of the driven blocks since the first
+    recorded frame, 0 where none moved that way."""
+    lo = 0.0
+    hi = 0.0
+    for b in range(m.block_mass.shape[0]):
+        if not m.block_free[b]:
+            d = s.position[b, i] - rec.position[0, b, i]
+            lo = min(lo, d)
+            hi = max(hi, d)
+    return lo, hi
+
+
 @njit(cache=True, _nrt=False)
 def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int) -> int:
     """Status of recorded frame ``frame``: STATUS_DIVERGED when the state is not finite or energy
@@ -406,7 +420,8 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     plus the work done on the model by more than DIVERGENCE_ERROR of the energy scale reached so far
     (kinetic + elastic + |potential change| + dissipated + |work|, at least the work of lifting the
     free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent (fell
-    through its support or flew away); else STATUS_DONE. ``sc.lost_block`` names the block (-1 for
+    through its support or flew away; the extent and the footprint below move with the driven
+    blocks); else STATUS_DONE. ``sc.lost_block`` names the block (-1 for
     an energy divergence). A block leaving the extent through its bottom outside the plan footprint
     of the driven blocks fell off the edge of the supports: its time is noted in ``s.fell_off``
     and it falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
@@ -426,20 +441,25 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     sc.lost_block[0] = -1
     if not (math.isfinite(err) and err <= DIVERGENCE_ERROR * sc.energy_scale[0]):
         return STATUS_DIVERGED
+    # The extent and the footprint move with the driven blocks (a foundation under a ground motion
+    # carries the blocks on it): widened by their displacement since the first frame.
+    lx, hx = _driven_shift(m, s, rec, 0)
+    ly, hy = _driven_shift(m, s, rec, 1)
+    lz, hz = _driven_shift(m, s, rec, 2)
     for b in range(m.block_mass.shape[0]):
         if not m.block_free[b] or s.fell_off[b] >= 0.0:
             continue
-        outside = False
-        for i in range(3):
-            x = s.position[b, i]
-            if not math.isfinite(x):
-                sc.lost_block[0] = b
-                return STATUS_DIVERGED
-            outside = outside or x < m.extent_low[i] or x > m.extent_high[i]
+        x, y, z = s.position[b, 0], s.position[b, 1], s.position[b, 2]
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+            sc.lost_block[0] = b
+            return STATUS_DIVERGED
+        low = z < m.extent_low[2] + lz
+        outside = (low or z > m.extent_high[2] + hz or x < m.extent_low[0] + lx or x > m.extent_high[0] + hx
+                   or y < m.extent_low[1] + ly or y > m.extent_high[1] + hy)
         if outside:
-            x, y, z = s.position[b, 0], s.position[b, 1], s.position[b, 2]
-            off_edge = not (m.support_low[0] <= x <= m.support_high[0] and m.support_low[1] <= y <= m.support_high[1])
-            if z < m.extent_low[2] and off_edge:
+            on_support = (m.support_low[0] + lx <= x <= m.support_high[0] + hx
+                          and m.support_low[1] + ly <= y <= m.support_high[1] + hy)
+            if low and not on_support:
                 s.fell_off[b] = rec.time[frame]
                 continue
             sc.lost_block[0] = b
