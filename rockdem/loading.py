@@ -122,10 +122,10 @@ def prepare_record(
     if window is not None:
         t0, t1 = float(window[0]), float(window[1])
         if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-            raise ValueError(f"{gm.name}: window must be (start, end) with end > start [s], got {window!r}")
+            raise ValueError(f"{gm.name}: window must be (start, end) with end > start [s], got ({t0:g}, {t1:g})")
         keep = (gm.time >= t0 - 1e-9 * gm.dt) & (gm.time <= t1 + 1e-9 * gm.dt)
         if keep.sum() < 2:
-            raise ValueError(f"{gm.name}: window {window!r} holds fewer than two samples "
+            raise ValueError(f"{gm.name}: window ({t0:g}, {t1:g}) holds fewer than two samples "
                              f"(record spans {gm.time[0]:g}..{gm.time[-1]:g} s)")
         vert = None if gm.vertical is None else gm.vertical[keep]
         gm = replace(gm, acceleration=gm.acceleration[keep], vertical=vert, start_time=float(gm.time[keep][0]))

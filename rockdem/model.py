@@ -931,11 +931,15 @@ def _vector3(value: ArrayLike, what: str) -> NDArray[np.float64]:
 
 #: Below these, a value is almost surely in the wrong unit (masonry: 1500-2500 kg/m^3, E >= 1 MPa).
 PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
+HEAVIEST_DENSITY = 12_000.0  # [kg/m^3] heavier than lead
 PLAUSIBLE_MODULUS = 1e6  # [Pa]
+PLAUSIBLE_FRICTION_ANGLE = 3.0  # [deg] below this a friction angle is likely a coefficient mu
 
 
 def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointMaterial], size: float) -> None:
-    """Warn about a density or a joint stiffness that looks given in t/m3 or MPa (SI is expected).
+    """Warn about a density or a joint stiffness that looks given in t/m3 or MPa (SI is expected),
+    a density heavier than any building material, and a friction angle that looks like a friction
+    coefficient.
 
     The joint stiffness is compared as the modulus it implies over the smallest free block
     dimension ``size`` [m] (kn = E / l, paper Eq. 12).
@@ -947,6 +951,21 @@ def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointM
                 f"(1500-2500 kg/m^3); if it is in t/m3, give it x 1000 (SI units: kg/m^3)", UserWarning, stacklevel=3,
             )
             break
+        if blk.driven is False and blk.density > HEAVIEST_DENSITY:
+            warnings.warn(
+                f"block {blk.name!r}: density {blk.density:g} kg/m^3 is heavier than any building material "
+                f"(masonry 1500-2500 kg/m^3, steel 7850); check its units (SI: kg/m^3)", UserWarning, stacklevel=3,
+            )
+            break
+    for (ga, gb), mat in mats.items():
+        for label, angle in (("friction_angle", mat.friction_angle), ("residual_friction_angle", mat.residual_friction_angle)):
+            if angle is not None and 0.0 < angle < PLAUSIBLE_FRICTION_ANGLE:
+                warnings.warn(
+                    f"joint {ga!r}-{gb!r}: {label} = {angle:g} deg is almost frictionless; if {angle:g} is a friction "
+                    f"coefficient mu, give the angle atan(mu) = {math.degrees(math.atan(angle)):.3g} deg",
+                    UserWarning, stacklevel=3,
+                )
+                break
     for (ga, gb), mat in mats.items():
         modulus = mat.kn * size
         if modulus < PLAUSIBLE_MODULUS:

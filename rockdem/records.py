@@ -514,8 +514,8 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
     steps = np.diff(t)
     if np.any(steps <= 0.0):
         j = int(np.flatnonzero(steps <= 0.0)[0])
-        raise ValueError(f"{p}, line {linenos[j + 1]}: time {t[j + 1]!r} does not increase "
-                         f"(previous {t[j]!r} on line {linenos[j]})")
+        raise ValueError(f"{p}, line {linenos[j + 1]}: time {float(t[j + 1]):g} does not increase "
+                         f"(previous {float(t[j]):g} on line {linenos[j]})")
     dt_typ = float(np.median(steps))
     # 1e-6 relative catches any missing or repeated sample; the eps term absorbs float noise in long times.
     tol = DT_RTOL * dt_typ + 16 * np.finfo(float).eps * float(np.max(np.abs(t)))

@@ -164,12 +164,15 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
     except ValueError as exc:
         return [_row("rocking analysis", "skipped", "", str(exc))]
     out = []
+    diverged = bool(ds.attrs.get("diverged"))
     for key, value in summary.items():
         label, unit, fmt = _ANALYSIS_ROWS.get(key, (key.replace("_", " "), "", ""))
         if key in skip:
             continue
         if isinstance(value, bool):
-            out.append(_row(label, "yes" if value else "no", unit))
+            # a run cut as diverged (sunk, lost, energy created) has no outcome: its last frames are unsound
+            note = "the run diverged: not an outcome" if diverged and key in ("exceeded_eta", "overturned") else ""
+            out.append(_row(label, "yes" if value else "no", unit, note))
         elif isinstance(value, (int, float, np.number)):
             out.append(_row(label, format(value, fmt or ".4g") if fmt != "d" else f"{int(value)}", unit))
         elif value is None:

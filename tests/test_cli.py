@@ -87,12 +87,19 @@ def test_summary_survives_a_run_stopped_at_zero_or_one_frame():
     from rockdem.simulation import simulate
 
     ds = simulate(rocking_block(0.2, 1.0, tilt=0.5), 0.02, record_interval=0.01)
+    sound = summary_lines(ds)
     for n in (0, 1):  # a run that diverges at t = 0 keeps 0 or 1 frames: IndexError before
         cut = ds.isel(time=slice(0, n))
         cut.attrs.update(diverged=1, diverged_time=0.0)
         lines = summary_lines(cut)
         assert any(line.startswith("DIVERGED at t = 0 s") for line in lines)
         assert any(line.startswith("time simulated") for line in lines)
+    # a diverged run's overturning flags are not an outcome, and say so; a sound run's carry no note
+    cut = ds.copy()
+    cut.attrs = {**ds.attrs, "diverged": 1, "diverged_time": 0.02}
+    flags = [line for line in summary_lines(cut) if line.startswith(("overturned", "exceeded eta"))]
+    assert len(flags) == 2 and all(line.endswith("the run diverged: not an outcome") for line in flags)
+    assert not any("diverged" in line for line in sound if line.startswith(("overturned", "exceeded")))
 
 
 def test_bad_output_folder_is_refused_before_the_run(tmp_path, capsys, monkeypatch):

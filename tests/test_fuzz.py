@@ -1000,18 +1000,21 @@ def _engine_cases(tmp: Path) -> list[FuzzCase]:
         _api("engine", "simulate_block", tokens=("youngs_modulus", "sank", "stopped"), expect="warn", youngs_modulus=3e4, duration=2.0),
         _api("engine", "simulate_block", tokens=("mpa", "youngs_modulus", "kn"), expect="warn", youngs_modulus=1800.0),
         _api("engine", "simulate_block", tokens=("density", "t/m3"), expect="warn", density=1.8),
+        _api("engine", "simulate_block", tokens=("density", "heavier"), expect="warn", density=1e6),
+        _api("engine", "simulate_block", tokens=("friction", "atan"), expect="warn", friction_angle=0.7),
         _api("engine", "simulate_arg", None, tokens=("model",)),
         _api("engine", "simulate_arg", "builder", tokens=("finalize",)),
     ]
 
 
-def _api_simulate_block(*, density=1800.0, kn=None, youngs_modulus=1.8e9, beta=0.0, dt=None, duration=0.01):
+def _api_simulate_block(*, density=1800.0, kn=None, youngs_modulus=1.8e9, beta=0.0, dt=None, duration=0.01,
+                        friction_angle=30.0):
     from rockdem.materials import JointMaterial
     from rockdem.model import Damping, ModelBuilder
     from rockdem.simulation import simulate
 
     b = ModelBuilder()
-    b.default_material = JointMaterial(kn=youngs_modulus / 1.0 if kn is None else kn)
+    b.default_material = JointMaterial(kn=youngs_modulus / 1.0 if kn is None else kn, friction_angle=friction_angle)
     b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
     b.add_box(0.2, 1, 1, density=density, name="block")
     b.tilt("block", 0.5)

@@ -402,3 +402,15 @@ def test_direction_vertical_and_resampling() -> None:
         GroundMotion(np.array([0.0, np.nan]), 0.01)
     with pytest.raises(ValueError, match="dt must be a positive"):
         GroundMotion(acc, 0.0)
+
+
+def test_window_and_time_errors_print_plain_numbers(tmp_path: Path) -> None:
+    """Errors give the numbers as written, not NumPy reprs (``np.float64(5.0)``)."""
+    gm = read_record("elcentro-rsn6")
+    with pytest.raises(ValueError, match=r"got \(5, 2\)$"):
+        prepare_record(gm, window=(np.float64(5.0), np.float64(2.0)))
+    with pytest.raises(ValueError, match=r"window \(100, 101\) holds fewer"):
+        prepare_record(gm, window=(100.0, 101.0))
+    bad = _write(tmp_path, "back.csv", "0.0,0.1\n0.01,0.2\n0.005,0.3\n0.02,0.1\n")
+    with pytest.raises(ValueError, match=r"line 3: time 0.005 does not increase \(previous 0.01 on line 2\)"):
+        read_record(bad, units="g")
