@@ -135,7 +135,7 @@ def simulate(
         threads: threads for the joint law of the face pairs (Numba's, at most as many as it was
             started with, ``NUMBA_NUM_THREADS``); the answer is the same bit for bit on any number.
             Default None: all of them for models of at least :data:`PARALLEL_MIN_BLOCKS` blocks,
-            one (serial) below. The parallel code is compiled on its first use (a few minutes once).
+            one (serial) below. The parallel code is compiled on its first use (under a minute, once).
             Runs made at once from several Python threads should give 1: Numba's default
             ``workqueue`` threading layer does not take parallel work from two threads at a time
             (the study runners, :mod:`rockdem.batch`, run one thread per run).
@@ -305,8 +305,8 @@ def run_model(
     finally:
         if bar is not None:
             bar.close()
-    # Past the loop every frame is computed: a stop signal from here on is held until the result is
-    # put together, and the result is returned (see _deferred_signals).
+    # Past the loop the frames are computed (all of them, or those before a stop): a stop signal from
+    # here on is held until the result is put together, and the result is returned (_deferred_signals).
     with _deferred_signals(finishing=True):
         if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
             decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)

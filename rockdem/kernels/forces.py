@@ -10,10 +10,13 @@ contacts were computed).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from .contact import (
     coulomb_limit,
@@ -374,17 +377,66 @@ def _law_pass(m: ModelArrays, s: State, sc: Scratch, dt: float, implicit: bool, 
     _law_pairs(m, s, sc, min(n, 0), n, dt, implicit, dashpots, sc.poly)
 
 
+@intrinsic
+def _stack_address(typingctx: Any, value: Any) -> Any:
+    """(value) -> uintp: the address of a copy of ``value`` (a tuple of arrays) on the calling
+    function's stack, valid until it returns."""
+
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        return builder.ptrtoint(cgutils.alloca_once_value(builder, args[0]), context.get_value_type(types.uintp))
+
+    return types.uintp(value), codegen
+
+
+@intrinsic
+def _type_of(typingctx: Any, value: Any) -> Any:
+    """(value) -> its type, as a value that costs nothing (for :func:`_load_at`)."""
+
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        return context.get_dummy_value()
+
+    return types.TypeRef(value)(value), codegen
+
+
+@intrinsic
+def _load_at(typingctx: Any, address: Any, like: Any) -> Any:
+    """(address, type) -> the value of that type stored at ``address`` by :func:`_stack_address`."""
+    ty = like.instance_type
+
+    def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
+        return builder.load(builder.inttoptr(args[0], context.get_value_type(ty).as_pointer()))
+
+    return ty(address, like), codegen
+
+
+@njit(cache=True, _nrt=False)
+def _law_chunk(pm: int, ps: int, psc: int, tm: Any, ts: Any, tsc: Any, first: int, last: int, dt: float,
+               implicit: bool, dashpots: bool, chunk: int) -> None:
+    """:func:`_law_pairs` for pairs first..last - 1 of chunk ``chunk``, on the model, state and
+    scratch stored at addresses pm, ps, psc (of types tm, ts, tsc) by :func:`_law_pass_parallel`."""
+    sc = _load_at(psc, tsc)
+    _law_pairs(_load_at(pm, tm), _load_at(ps, ts), sc, first, last, dt, implicit, dashpots, sc.chunk_poly[chunk])
+
+
 @njit(cache=True, _nrt=False, parallel=True)
 def _law_pass_parallel(m: ModelArrays, s: State, sc: Scratch, dt: float, implicit: bool, dashpots: bool) -> None:
     """:func:`_law_pass` over LAW_CHUNKS fixed chunks of the pairs on Numba's threads (the same
     answer on any number of threads: every pair writes only its own entries). Each chunk is one
     call of the compiled :func:`_law_pairs`: the law inlined into the loop of a ``parallel=True``
     function lost its writes to the state's arrays (Numba 0.68's parfor passes took them for dead
-    code)."""
+    code).
+
+    The model, state and scratch enter the parallel region as three addresses, not as tuples:
+    Numba unpacks tuples that enter a parallel region into one gufunc argument per array, and
+    its compile time grows steeply with their number (their 200 arrays took 15 to 20 minutes to
+    compile on a slow machine; benchmarks/parfor_tuple_compile.py). The copies they point to live
+    on this function's stack for the whole parallel loop."""
     n = s.pair_count[0]
     per = (n + LAW_CHUNKS - 1) // LAW_CHUNKS
+    pm, ps, psc = _stack_address(m), _stack_address(s), _stack_address(sc)
+    tm, ts, tsc = _type_of(m), _type_of(s), _type_of(sc)
     for chunk in numba.prange(LAW_CHUNKS):
-        _law_pairs(m, s, sc, min(n, chunk * per), min(n, (chunk + 1) * per), dt, implicit, dashpots, sc.chunk_poly[chunk])
+        _law_chunk(pm, ps, psc, tm, ts, tsc, min(n, chunk * per), min(n, (chunk + 1) * per), dt, implicit, dashpots, chunk)
 
 
 @njit(cache=True, _nrt=False)

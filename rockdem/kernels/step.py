@@ -544,5 +544,5 @@ def advance(
 advance_parallel = njit(cache=True, _nrt=False)(rebind(advance.py_func, "advance_parallel", compute_forces=compute_forces_parallel))
 """(m, s, sc, t_stop, record_interval, rec, frame) -> (frame, status): :func:`advance` with the face
 pairs' joint law on Numba's threads (:func:`rockdem.kernels.forces.compute_forces_parallel`): the
-same answer bit for bit on any number of threads. Compiled on first use only (``parallel=True``
-code compiles slowly)."""
+same answer bit for bit on any number of threads. Compiled on first use only (a one-thread run
+never pays for it)."""
