@@ -297,8 +297,8 @@ class GroundMotion:
         :func:`rockdem.loading.prepare_record`) is then taken out smoothly over the last tenth of the
         record (at least two samples): a deceleration V r'(t), r = sin^2 rising from 0 to 1, sized so
         that the record followed by zero acceleration (:meth:`with_tail`) ends exactly at rest (a
-        trapezoid integral). The record before that last tenth is unchanged, a permanent ground
-        displacement (a velocity pulse) is kept. The vertical component, if any, is corrected the
+        trapezoid integral). Before that last tenth the record is only trend-corrected, and a
+        permanent ground displacement (a velocity pulse) is kept. The vertical component, if any, is corrected the
         same way, separately.
 
         Args:

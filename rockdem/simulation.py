@@ -500,10 +500,10 @@ class _Saver:
 def _deferred_signals(finishing: bool = False) -> Iterator[None]:
     """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
     deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
-    halfway through it. With ``finishing`` (the result of a run whose frames are all computed being
-    put together), the KeyboardInterrupt the handler raises is caught, so that the result is
-    returned; the handler has seen the signal (``rockdem run`` then notes it and exits once the
-    result is saved). Outside the main thread (where no signal arrives) this does nothing."""
+    halfway through it. With ``finishing`` (the result of a run being put together once its loop
+    has ended: every frame computed, or those before a stop), the KeyboardInterrupt the handler
+    raises is caught, so that the result is returned; the handler has seen the signal (``rockdem
+    run`` then notes it and exits once the result is saved). Outside the main thread (where no signal arrives) this does nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
