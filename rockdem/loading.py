@@ -193,10 +193,15 @@ def apply_earthquake(
     acc = gm.vector_acceleration()
     vel = gm.vector_velocity()  # from rest: v(t_0) = 0
     t = delay + gm.dt * np.arange(gm.npts)
-    if delay > 0.0:  # at rest until the record starts
-        t = np.r_[0.0, t]
-        acc = np.vstack([np.zeros((1, 3)), acc])
-        vel = np.vstack([np.zeros((1, 3)), vel])
+    if delay > 0.0:
+        # At rest until the record starts: zero acceleration up to a thousandth of a sample before
+        # it (a ramp from 0 at t = 0 up to the first sample would move the ground before the
+        # record, by a0 delay^2 / 6, and its velocity would jump back to zero at the delay).
+        jump = 1e-3 * gm.dt
+        lead = np.array([0.0, delay - jump]) if delay > 2.0 * jump else np.array([0.0])
+        t = np.r_[lead, t]
+        acc = np.vstack([np.zeros((lead.size, 3)), acc])
+        vel = np.vstack([np.zeros((lead.size, 3)), vel])
     if mode == "foundation":
         if builder.ground_motion is not None:
             raise ValueError("the builder already has a ground motion; apply one earthquake per model")
@@ -533,21 +538,22 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
 # -- TOML loading types ------------------------------------------------------------------------
 
 
-def _read_table_record(t: Table, key: str, units: str | None, dt: float | None) -> GroundMotion:
-    return _read_cached(str(record_path(t.string(key))), units, dt)
+def _read_table_record(t: Table, key: str, units: str | None, dt: float | None, columns: tuple[int | None, int | None]) -> GroundMotion:
+    return _read_cached(str(record_path(t.string(key))), units, dt, columns)
 
 
-def _read_cached(path: str, units: str | None, dt: float | None) -> GroundMotion:
+def _read_cached(path: str, units: str | None, dt: float | None, columns: tuple[int | None, int | None] = (None, None)) -> GroundMotion:
     """:func:`read_record`, remembered per process by file, size and modification time (a record
     read for every run of a study is parsed once; an edited file is read again). GroundMotion is
-    immutable, so the runs share it safely."""
+    immutable, so the runs share it safely. ``columns``: (time_column, acc_column) or Nones."""
     st = os.stat(path)
-    return _read_record_at(path, st.st_size, st.st_mtime_ns, units, dt)
+    return _read_record_at(path, st.st_size, st.st_mtime_ns, units, dt, columns)
 
 
 @functools.lru_cache(maxsize=64)
-def _read_record_at(path: str, size: int, mtime_ns: int, units: str | None, dt: float | None) -> GroundMotion:
-    return read_record(path, units=units, dt=dt)
+def _read_record_at(path: str, size: int, mtime_ns: int, units: str | None, dt: float | None,
+                    columns: tuple[int | None, int | None]) -> GroundMotion:
+    return read_record(path, units=units, dt=dt, time_column=columns[0], acc_column=columns[1])
 
 
 def _earthquake_settings(t: Table) -> dict[str, Any]:
@@ -557,10 +563,11 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
     if units is not None and not isinstance(units, str):
         raise ValueError(f"[{t.where}] units must be a string such as \"g\", got {units!r}")
     dt = t.optional_number("dt", positive=True)
-    gm = _read_table_record(t, "record", units, dt)
+    columns = tuple(t.integer(key) if key in t.data else None for key in ("time_column", "acc_column"))
+    gm = _read_table_record(t, "record", units, dt, columns)
     vert = t.raw("vertical", False)
     if isinstance(vert, str):
-        gv = read_record(vert, units=units, dt=dt)
+        gv = read_record(vert, units=units, dt=dt, time_column=columns[0], acc_column=columns[1])
         n = min(gv.npts, gm.npts)
         if abs(gv.dt - gm.dt) > 1e-9 * gm.dt:
             raise ValueError(f"[{t.where}] vertical record dt {gv.dt} s differs from the record's {gm.dt} s")
@@ -610,9 +617,16 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
     units ("g", "m/s2", "cm/s2"; optional for AT2 and shipped records), dt [s] (single-column files), scale (default 1) or pga_g
     (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
     the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
-    baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0).
+    baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0, before
+    the run's end), time_column and acc_column (zero-based columns of a time/acceleration file
+    with more than two columns; defaults 0 and 1).
     """
-    info = apply_earthquake(b, **_earthquake_settings(t))
+    settings = _earthquake_settings(t)
+    duration = ctx["run"].duration
+    if settings["delay"] >= duration:
+        raise ValueError(f"[{t.where}] delay = {settings['delay']:g} s is not before the run's end (run.duration = "
+                         f"{duration:g} s): the record would never act; shorten the delay or lengthen the run")
+    info = apply_earthquake(b, **settings)
     ctx["attrs"].update(
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,

@@ -24,6 +24,7 @@ import functools
 import hashlib
 import os
 import re
+import warnings
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from importlib import resources
@@ -388,8 +389,17 @@ _UNITS_RE = re.compile(r"UNITS\s+(?:OF|ARE|IN|:)?\s*\(?\s*([A-Za-z'/^*0-9]+)", r
 _NOT_ACCEL_RE = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b.*\bUNITS?\b", re.IGNORECASE)
 
 
-def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, AccelerationUnit | None]:
-    """Line index of the NPTS/DT line, NPTS, DT [s] and the header's units (None if not stated)."""
+def _half_last_digit(text: str) -> float:
+    """Half a unit in the last digit of a number as written (``".0029"``: 5e-5, ``"1.0E-02"``:
+    5e-4): how far the value it stands for may be from it by rounding alone."""
+    mantissa, _, exponent = text.upper().replace("D", "E").partition("E")
+    decimals = len(mantissa.partition(".")[2])
+    return 0.5 * 10.0 ** (-decimals + (int(exponent) if exponent else 0))
+
+
+def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, AccelerationUnit | None, float]:
+    """Line index of the NPTS/DT line, NPTS, DT [s], the header's units (None if not stated) and
+    the rounding of DT as written [s] (half a unit in its last digit)."""
     for i, line in enumerate(lines[:_HEADER_SCAN_LINES]):
         m_n, m_dt = _NPTS_RE.search(line), _DT_RE.search(line)
         old = _OLD_NPTS_DT_RE.search(line)
@@ -408,7 +418,7 @@ def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, Acceleratio
             m_u = _UNITS_RE.search(head)
             if m_u:
                 header_units = _parse_units(m_u.group(1).rstrip(").,"), f"{p}: header units")
-        return i, npts, dt, header_units
+        return i, npts, dt, header_units, _half_last_digit(dt_text)
     raise ValueError(f"{p}: no 'NPTS= ..., DT= ...' header line in the first {_HEADER_SCAN_LINES} lines; "
                      "for a headerless file use read_single_column(path, dt=..., units=...) or read_columns")
 
@@ -426,7 +436,9 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
         path: the file.
         units: units of the values. Default: those the header states ("UNITS OF G", "units are (g)"),
             else g. An explicit value that contradicts the header is an error.
-        dt: time step [s] overriding the header's (which some files round, e.g. ``.0029``).
+        dt: time step [s] overriding the header's (which some files round, e.g. ``.0029``). A
+            dt farther from the header's than its rounding (half a unit in its last digit) is
+            used, with a warning: it stretches or shrinks the record in time.
 
     Returns:
         The record in m/s^2, named after the file stem, with header line 2 as description.
@@ -437,7 +449,7 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
             different from NPTS, bad units or dt.
     """
     p, lines = _read_lines(path)
-    i_head, npts, dt_head, header_units = _at2_header(p, lines)
+    i_head, npts, dt_head, header_units, rounding = _at2_header(p, lines)
     unit = header_units or AccelerationUnit.G
     if units is not None:
         unit = _parse_units(units, f"{p}: units")
@@ -453,6 +465,10 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
     step = dt_head if dt is None else dt
     if not np.isfinite(step) or step <= 0.0:
         raise ValueError(f"{p}: dt must be positive, got {step!r} (pass dt=... to override the header)")
+    if dt is not None and abs(dt - dt_head) > rounding * (1.0 + 1e-9):
+        warnings.warn(f"{p}: dt = {dt:g} s overrides the header's DT = {dt_head:g} s (line {i_head + 1}), more "
+                      f"than its rounding ({rounding:g} s): the record's {npts * dt_head:g} s become "
+                      f"{npts * dt:g} s; omit dt to use the header's", UserWarning, stacklevel=2)
     # NGA files put the event and station on line 2 under a fixed banner; other variants on line 1.
     banner = lines[0].strip().upper().startswith("PEER")
     description = lines[1].strip() if banner and i_head >= 2 else lines[0].strip() if i_head >= 1 else ""
@@ -562,11 +578,14 @@ def read_single_column(path: str | os.PathLike[str], *, dt: float, units: str | 
     return GroundMotion.from_samples(values, dt=dt, units=unit, name=p.stem, source=p)
 
 
-def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
-    if p.suffix.lower() == ".at2":
-        return RecordFormat.AT2
+def _is_at2(p: Path, lines: list[str]) -> bool:
+    """A ``.AT2`` suffix or an NPTS/DT header line."""
     head = lines[:_HEADER_SCAN_LINES]
-    if any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head):
+    return p.suffix.lower() == ".at2" or any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head)
+
+
+def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
+    if _is_at2(p, lines):
         return RecordFormat.AT2
     for line in lines:
         text = line.split("#", 1)[0]
@@ -576,13 +595,15 @@ def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
                 return RecordFormat.SINGLE
             if count == 2:
                 return RecordFormat.COLUMNS
-            raise ValueError(f"{p}: cannot tell the format from a first data line of {count} values; "
-                             "call read_columns (time_column=..., acc_column=...) or read_at2 directly")
+            raise ValueError(f"{p}: cannot tell the format from a first data line of {count} values; give the "
+                             "columns: time_column and acc_column (zero-based; in a case file, keys of [loading], "
+                             "e.g. time_column = 0, acc_column = 2), or call read_columns")
     raise ValueError(f"{p}: no numeric data line found")
 
 
 def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit | None = None,
-                dt: float | None = None, format: str | RecordFormat | None = None) -> GroundMotion:
+                dt: float | None = None, format: str | RecordFormat | None = None,
+                time_column: int | None = None, acc_column: int | None = None) -> GroundMotion:
     """Read a ground-motion record of any supported format, from a file or by name.
 
     The format is ``format`` if given, else AT2 for a ``.AT2`` suffix or an NPTS/DT header line, else
@@ -596,14 +617,31 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
         dt: time step [s]; required for single-column files, overrides the header for AT2, and for
             two-column files must agree with the time column.
         format: "at2", "columns" or "single".
+        time_column, acc_column: zero-based columns of the time [s] and the acceleration of a
+            columns file (defaults 0 and 1); giving either reads the file as columns.
     """
+    columns = {"time_column": 0 if time_column is None else time_column, "acc_column": 1 if acc_column is None else acc_column}
+    for key, value in columns.items():
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
+            raise ValueError(f"{path}: {key} must be a zero-based column index (0, 1, 2, ...), got {value!r}")
+    if columns["time_column"] == columns["acc_column"]:
+        raise ValueError(f"{path}: time_column and acc_column are both {columns['acc_column']}; give two different columns")
+    chosen = time_column is not None or acc_column is not None
     found = record_path(path)
     if units is None and (entry := _shipped_entry(found)) is not None:
         units = entry.units
     p, lines = _read_lines(found)
     if format is not None and str(format).lower() not in {f.value for f in RecordFormat}:
         raise ValueError(f"{p}: unknown format {format!r}; use 'at2', 'columns' or 'single' (or omit it)")
-    fmt = RecordFormat(str(format).lower()) if format is not None else _sniff_format(p, lines)
+    if format is not None:
+        fmt = RecordFormat(str(format).lower())
+    elif chosen:  # columns chosen: a columns file of any width, unless it is an AT2 file
+        fmt = RecordFormat.AT2 if _is_at2(p, lines) else RecordFormat.COLUMNS
+    else:
+        fmt = _sniff_format(p, lines)
+    if chosen and fmt is not RecordFormat.COLUMNS:
+        raise ValueError(f"{p}: time_column and acc_column choose the columns of a time/acceleration file, "
+                         f"and do not apply to the {fmt.value} format; leave them out")
     if fmt is RecordFormat.AT2:
         return read_at2(p, units=units, dt=dt)
     if units is None:
@@ -614,7 +652,7 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
             raise ValueError(f"{p} is a single-column file with no time information; pass dt=<time step "
                              "in seconds>")
         return read_single_column(p, dt=dt, units=units)
-    gm = read_columns(p, units=units)
+    gm = read_columns(p, units=units, time_column=int(columns["time_column"]), acc_column=int(columns["acc_column"]))
     if dt is not None and abs(gm.dt - dt) > DT_RTOL * dt:
         raise ValueError(f"{p}: dt={dt!r} disagrees with the time column's {gm.dt!r} s; omit dt")
     return gm

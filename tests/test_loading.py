@@ -14,7 +14,7 @@ import pytest
 
 from rockdem.case import load_case, parse_case
 from rockdem.kernels.rotation import quats_to_matrices
-from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, pushover, resolve_record, rigid_rod_load_factor
+from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, earthquake_record, pushover, resolve_record, rigid_rod_load_factor
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.records import read_record
@@ -233,3 +233,23 @@ def test_a_block_riding_on_a_moving_foundation_is_not_lost():
     assert x[-1, 0] == pytest.approx(4.75, abs=1e-3)  # the foundation moved past the extent of the start
     np.testing.assert_allclose(x[:, 1], x[:, 0], atol=1e-3)  # the block moved with it
     np.testing.assert_allclose(ds.block_position.values[:, 1, 2], 0.125, atol=1e-4)
+
+
+def test_an_earthquake_delayed_past_the_run_is_refused():
+    # A delay at or past the run's end would leave the record unapplied: refused, naming both keys;
+    # a delay inside the run starts the record then (its samples shifted by the delay), the
+    # ground still before it.
+    data = load_case(EXAMPLES / "elcentro_block_foundation.toml")
+    data["run"]["duration"] = 0.3
+    data["loading"]["delay"] = 0.3
+    with pytest.raises(ValueError, match=r"delay = 0.3 s is not before the run's end \(run.duration = 0.3 s\)"):
+        parse_case(data)
+    data["loading"]["delay"] = 0.2
+    ds = run_case(parse_case(data), progress=False)
+    t, ag = ds.time.values, ds.ground_acceleration.values[:, 0]
+    gm = earthquake_record(data["loading"])
+    late = t >= 0.2
+    np.testing.assert_allclose(ag[late], np.interp(t[late] - 0.2, gm.time, gm.acceleration), rtol=1e-9, atol=1e-12)
+    assert np.all(ag[t < 0.2 - 1e-5] == 0.0)
+    assert np.max(np.abs(ds.ground_displacement.values[t < 0.2])) < 1e-9
+    assert np.max(np.abs(ds.ground_displacement.values[-1])) > 1e-5

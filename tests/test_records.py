@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -225,9 +226,51 @@ def test_at2_header_units_and_conflict(tmp_path: Path) -> None:
 
 
 def test_at2_dt_override(tmp_path: Path) -> None:
-    """dt= overrides a header dt rounded to 4 decimals (the Italian records' case)."""
+    """dt= overrides a header dt rounded to 4 decimals (the Italian records' case) silently; a dt
+    beyond the header's rounding (half a unit in its last digit) is used with a warning that
+    gives the stretched duration."""
     path = _write(tmp_path, "d.AT2", NGA_HEADER + "NPTS= 2, DT= .0029 SEC\n .1 .2\n")
-    assert read_at2(path, dt=0.00293).dt == 0.00293
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_at2(path, dt=0.00293).dt == 0.00293
+        assert read_at2(path, dt=0.00285).dt == 0.00285  # .0029 is 0.00285 .. 0.00295 rounded
+    with pytest.warns(UserWarning, match=r"overrides the header's DT = 0.0029 s .*0.0058 s become 0.0116 s"):
+        assert read_at2(path, dt=0.0058).dt == 0.0058
+    path = _write(tmp_path, "e.AT2", NGA_HEADER + "NPTS= 2, DT= 1.0E-02 SEC\n .1 .2\n")  # rounding 5e-4
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read_at2(path, dt=0.0104)
+    with pytest.warns(UserWarning, match="more than its rounding"):
+        read_at2(path, dt=0.0106)
+
+
+def test_columns_chosen_in_a_wider_file(tmp_path: Path) -> None:
+    """A time/velocity/acceleration file: its width alone is refused with the keys to give, and
+    time_column / acc_column choose the columns (read_record, and the case file's [loading])."""
+    path = _write(tmp_path, "three.csv", "# t, v, a\n0.00, 9, 0.0\n0.01, 9, 0.1\n0.02, 9, -0.2\n0.03, 9, 0.0\n")
+    with pytest.raises(ValueError, match="time_column = 0, acc_column = 2"):
+        read_record(path, units="g")
+    gm = read_record(path, units="g", acc_column=2)
+    np.testing.assert_allclose(gm.acceleration / STANDARD_GRAVITY, [0.0, 0.1, -0.2, 0.0], rtol=1e-15)
+    assert gm.dt == pytest.approx(0.01, rel=1e-12)
+    with pytest.raises(ValueError, match="both 1"):
+        read_record(path, units="g", time_column=1)
+    with pytest.raises(ValueError, match="zero-based column index"):
+        read_record(path, units="g", acc_column=-1)
+    with pytest.raises(ValueError, match="do not apply to the at2 format"):
+        read_record(_write(tmp_path, "f.AT2", NGA_HEADER + "NPTS= 2, DT= .01 SEC\n .1 .2\n"), acc_column=2)
+    from rockdem.case import parse_case
+    from rockdem.run_cli import run_case
+
+    case = {"run": {"duration": 0.05, "record_interval": 0.01},
+            "specimen": {"type": "block", "width": 0.2, "height": 1.0, "length": 0.5, "youngs_modulus": 1.8e9},
+            "loading": {"type": "earthquake", "record": str(path), "units": "g", "acc_column": 2, "baseline": False}}
+    ds = run_case(parse_case(case), progress=False)
+    t = ds.time.values
+    np.testing.assert_allclose(ds.ground_acceleration.values[:, 0], np.interp(t, [0, 0.01, 0.02, 0.03], [0, 0.1 * STANDARD_GRAVITY, -0.2 * STANDARD_GRAVITY, 0]), atol=1e-9)
+    case["loading"]["acc_column"] = "2"
+    with pytest.raises(ValueError, match=r"\[loading\] acc_column must be an integer"):
+        parse_case(case)
 
 
 def test_malformed_token_names_line(tmp_path: Path) -> None:
