@@ -38,7 +38,7 @@ import math
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 import xarray as xr
@@ -63,6 +63,8 @@ __all__ = [
     "apply_rod_pushover",
     "rigid_rod_load_factor",
     "pushover",
+    "load_carried",
+    "LoadCarried",
     "capacity_curve",
 ]
 
@@ -521,6 +523,66 @@ def capacity_curve(
     else:
         lam = -(ds.base_reaction.values @ d) / weight
     return lam, disp
+
+
+EQUILIBRIUM_TOLERANCE = 0.05
+"""A load-controlled pushover is out of static equilibrium where the base reaction, averaged over
+:data:`EQUILIBRIUM_WINDOW` of the run, falls short of the applied load by more than this share of
+it (the rest accelerates the specimen)."""
+
+EQUILIBRIUM_WINDOW = 0.1
+"""Share of the run (at least 3 frames) over which the base reaction is averaged for that test:
+impacts of the base's points make it ring by +-10 %, the shortfall that moves the specimen lasts."""
+
+
+class LoadCarried(NamedTuple):
+    """What a load-controlled pushover's specimen carried (:func:`load_carried`).
+
+    Attributes:
+        peak: largest load factor of the base reaction, lambda = -R.d / W [-].
+        peak_time: its time [s].
+        applied: the applied load factor at the last frame [-].
+        held: the base reaction's load factor averaged over the last ``window`` seconds [-].
+        window: that averaging time [s] (:data:`EQUILIBRIUM_WINDOW` of the run).
+        exceeded: time [s] from which the reaction, averaged over the frames before it
+            (:data:`EQUILIBRIUM_WINDOW`), stays short of the applied load by more than
+            :data:`EQUILIBRIUM_TOLERANCE` of it to the end (the load exceeded what the specimen
+            carries and it accelerates), or None when it ends in equilibrium.
+    """
+
+    peak: float
+    peak_time: float
+    applied: float
+    held: float
+    window: float
+    exceeded: float | None
+
+
+def load_carried(ds: xr.Dataset) -> LoadCarried | None:
+    """The base reaction of a load-controlled pushover against its applied ramp (None for another
+    result): a ramp that passes the specimen's capacity reads as carried on the ramp's own curve,
+    while the specimen is accelerating, out of equilibrium, from where the reaction falls behind."""
+    a = ds.attrs
+    if a.get("pushover_rate") is None or a.get("pushover_rod") is not None or "base_reaction" not in ds or ds.sizes.get("time", 0) < 2:
+        return None
+    monitor = str(ds.monitor.values[0]) if ds.sizes.get("monitor", 0) else None
+    if monitor is None:
+        return None
+    applied, _ = capacity_curve(ds, monitor, source="ramp")
+    reaction, _ = capacity_curve(ds, monitor, source="reaction")
+    t = ds.time.values
+    w = max(3, int(round(EQUILIBRIUM_WINDOW * t.size)))
+    sums = np.cumsum(np.r_[0.0, applied - reaction])
+    start = np.maximum(np.arange(1, t.size + 1) - w, 0)
+    shortfall = (sums[1:] - sums[start]) / (np.arange(1, t.size + 1) - start)  # trailing mean (T,)
+    short = shortfall > EQUILIBRIUM_TOLERANCE * applied
+    exceeded = None
+    if short[-1]:
+        held = np.flatnonzero(~short)
+        exceeded = float(t[held[-1] + 1]) if held.size else float(t[0])
+    k = int(np.argmax(reaction))
+    held = float(np.mean(reaction[-w:]))
+    return LoadCarried(float(reaction[k]), float(t[k]), float(applied[-1]), held, float(t[-1] - t[-w]), exceeded)
 
 
 def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: str) -> NDArray[np.float64]:

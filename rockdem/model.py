@@ -282,6 +282,7 @@ class Model:
                     "beta_choice=rockdem.targeting.choose_beta(builder, model, damping) or use ModelBuilder.finalize"
                 )
             fields.update(damping_arrays(self.materials, self.group_names, damping, beta_choice))
+            _warn_implausible_damping(self, damping)
             new_damping = damping if beta_choice is None else replace(damping, beta=beta_choice.beta)
             choice = beta_choice
         elif beta_choice is not None:
@@ -824,6 +825,7 @@ class ModelBuilder:
             rocking_axis=axis / np.linalg.norm(axis),
             materials=mats,
         )
+        _warn_implausible_damping(model, damping)
         if damping.beta_mode is None:
             return model
         from .targeting import choose_beta  # runs simulations of the model (imports simulate)
@@ -934,6 +936,55 @@ PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
 HEAVIEST_DENSITY = 12_000.0  # [kg/m^3] heavier than lead
 PLAUSIBLE_MODULUS = 1e6  # [Pa]
 PLAUSIBLE_FRICTION_ANGLE = 3.0  # [deg] below this a friction angle is likely a coefficient mu
+
+
+OVERDAMPED_BETA = 10.0
+"""A numeric beta this many times the largest critical value 2 / omega of the model's joints is
+warned about (DeJong's beta, paper §2.2, is the critical one)."""
+
+
+def _warn_implausible_damping(model: Model, damping: Damping) -> None:
+    """Warn about Rayleigh coefficients that over-damp every motion of the model.
+
+    * alpha [1/s] above 2 sqrt(g / d), d the smallest dimension of the free blocks: critical damping
+      of the fastest motion gravity drives (a pendulum of length d); under it blocks creep, their
+      velocities decaying within 1 / alpha (the paper's MP values are 0.05 to 1 1/s).
+    * a numeric beta [s] above :data:`OVERDAMPED_BETA` times the largest critical beta 2 / omega,
+      omega = sqrt(kn A / m) of a free block on its smallest face (its two smallest extents: the
+      slowest of its impacts, DeJong's omega_e of a block standing on its base) and softest joint: every impact is over-damped that many times, and a block settles into
+      its joint over about beta seconds instead of bouncing.
+    """
+    m = model.arrays
+    free = np.flatnonzero(m.block_free)
+    g = float(np.linalg.norm(m.gravity))
+    if not free.size:
+        return
+    start = m.block_vertex_start
+    extents = np.array([np.sort(np.ptp(m.vertex_local[start[b]:start[b + 1]], axis=0)) for b in free])  # (nf, 3) ascending
+    smallest = float(extents[:, 0].min())
+    if g > 0.0 and damping.alpha > 2.0 * math.sqrt(g / smallest):
+        warnings.warn(
+            f"damping.alpha = {damping.alpha:g} 1/s over-damps every motion of the blocks: it is above "
+            f"2 sqrt(g / d) = {2.0 * math.sqrt(g / smallest):.3g} 1/s (critical for a pendulum of the smallest block "
+            f"dimension d = {smallest:g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
+            "paper's MP values are 0.05 to 1 1/s (alpha = 22.4 beta + 0.05)", UserWarning, stacklevel=3,
+        )
+    beta = damping.beta
+    if isinstance(beta, str) or not beta > 0.0:
+        return
+    groups = m.block_group[free]
+    softest = np.array([float(np.min(m.mat_kn[gr][m.mat_kn[gr] > 0.0])) if np.any(m.mat_kn[gr] > 0.0) else np.inf for gr in groups])
+    omega = np.sqrt(softest * extents[:, 0] * extents[:, 1] / m.block_mass[free])
+    k = int(np.argmin(omega))
+    critical = 2.0 / float(omega[k])
+    if beta > OVERDAMPED_BETA * critical:
+        warnings.warn(
+            f"damping.beta = {beta:g} s is {beta / critical:.3g} times the critical value 2 / omega = {critical:.3g} s "
+            f"of the slowest impact (block {model.block_names[int(free[k])]!r} on its smallest face, omega = "
+            f"{float(omega[k]):.4g} rad/s): every impact is over-damped, blocks settle into their joints over about "
+            f"beta seconds; DeJong's beta (paper §2.2) is the critical one (damping.beta = \"critical\")",
+            UserWarning, stacklevel=3,
+        )
 
 
 def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointMaterial], size: float) -> None:

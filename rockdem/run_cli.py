@@ -17,6 +17,7 @@ import xarray as xr
 from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, positive_int, stop_on_signals
+from .loading import load_carried
 from .results import export_csv, save, write_contact_table
 from .simulation import _deferred_signals, simulate
 from .stopping import STOP_MODES
@@ -123,6 +124,10 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         if "energy_balance_error_relative" in ds:
             err = float(np.max(np.abs(ds.energy_balance_error_relative.values)))
             lines.append(_row("energy balance error", f"{err:.2e}", "", "largest, relative"))
+        carried = load_carried(ds)
+        if carried is not None:
+            lines.append(_row("load factor carried", f"{carried.peak:.4g}", "",
+                              f"peak of base reaction / weight (with its ringing), at t = {carried.peak_time:.4g} s; applied at the end {carried.applied:.4g}"))
         npts = max(int(a.get("point_count", 1)), 1)
         for mode in ("shear", "tension"):
             var = f"contacts_failed_{mode}"
@@ -143,6 +148,12 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         what = {"overturned": f"block {a.get('stop_block')!r} overturned", "fell": f"block {a.get('stop_block')!r} fell",
                 "rest": "at rest after the input"}.get(a["stop_reason"], a["stop_reason"])
         lines.append(f"STOPPED at t = {a['stop_time']:.4g} s: {what} (stop = {a.get('stop_rule')!r}); the outcome was decided")
+    carried = load_carried(ds) if n else None
+    if carried is not None and carried.exceeded is not None:
+        lines.append(f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s: the base reaction carries "
+                     f"{carried.held:.4g} of the applied load factor {carried.applied:.4g} (mean of the last {carried.window:.3g} s) "
+                     "and the rest accelerates the specimen; the ramp's curve past that time is not a capacity "
+                     "(follow the softening branch with [loading] mode = \"displacement\")")
     if a.get("diverged"):
         lines.append(f"DIVERGED at t = {a['diverged_time']:.4g} s: the result holds the sound frames before it")
     if a.get("interrupted"):

@@ -1002,12 +1002,14 @@ def _engine_cases(tmp: Path) -> list[FuzzCase]:
         _api("engine", "simulate_block", tokens=("density", "t/m3"), expect="warn", density=1.8),
         _api("engine", "simulate_block", tokens=("density", "heavier"), expect="warn", density=1e6),
         _api("engine", "simulate_block", tokens=("friction", "atan"), expect="warn", friction_angle=0.7),
+        _api("engine", "simulate_block", tokens=("alpha", "over-damps"), expect="warn", alpha=1e12),
+        _api("engine", "simulate_block", tokens=("beta", "critical"), expect="warn", beta=10.0),
         _api("engine", "simulate_arg", None, tokens=("model",)),
         _api("engine", "simulate_arg", "builder", tokens=("finalize",)),
     ]
 
 
-def _api_simulate_block(*, density=1800.0, kn=None, youngs_modulus=1.8e9, beta=0.0, dt=None, duration=0.01,
+def _api_simulate_block(*, density=1800.0, kn=None, youngs_modulus=1.8e9, alpha=0.0, beta=0.0, dt=None, duration=0.01,
                         friction_angle=30.0):
     from rockdem.materials import JointMaterial
     from rockdem.model import Damping, ModelBuilder
@@ -1018,7 +1020,7 @@ def _api_simulate_block(*, density=1800.0, kn=None, youngs_modulus=1.8e9, beta=0
     b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
     b.add_box(0.2, 1, 1, density=density, name="block")
     b.tilt("block", 0.5)
-    return simulate(b.finalize(damping=Damping(beta=beta)), duration, dt=dt, progress=False)
+    return simulate(b.finalize(damping=Damping(alpha=alpha, beta=beta)), duration, dt=dt, progress=False)
 
 
 def _api_simulate_arg(what):

@@ -14,11 +14,11 @@ import pytest
 
 from rockdem.case import load_case, parse_case
 from rockdem.kernels.rotation import quats_to_matrices
-from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, earthquake_record, pushover, resolve_record, rigid_rod_load_factor
+from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, earthquake_record, load_carried, pushover, resolve_record, rigid_rod_load_factor
 from rockdem.materials import JointMaterial
 from rockdem.model import Damping, ModelBuilder
 from rockdem.records import read_record
-from rockdem.run_cli import run_case
+from rockdem.run_cli import run_case, summary_lines
 from rockdem.simulation import simulate
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -253,3 +253,25 @@ def test_an_earthquake_delayed_past_the_run_is_refused():
     assert np.all(ag[t < 0.2 - 1e-5] == 0.0)
     assert np.max(np.abs(ds.ground_displacement.values[t < 0.2])) < 1e-9
     assert np.max(np.abs(ds.ground_displacement.values[-1])) > 1e-5
+
+
+@pytest.mark.parametrize("max_load_factor", [0.08, 0.12])
+def test_a_load_past_the_capacity_is_not_read_as_carried(max_load_factor):
+    # A 0.2 x 2 m block (rigid capacity B/H = 0.1) under a ramp of 0.1/s to 0.08 or 0.12, held to
+    # 1.5 s. Below the capacity the base reaction carries the load (within 5 %); above it the
+    # block accelerates, and the summary says from when: not before the ramp reaches B/H (1.0 s).
+    data = load_case(EXAMPLES / "pushover_0.2x2.0_points2.toml")
+    data["loading"].update(max_load_factor=max_load_factor, rate=0.1)
+    data["run"].update(duration=1.5, record_interval=0.01)
+    ds = run_case(parse_case(data), progress=False)
+    carried = load_carried(ds)
+    lines = "\n".join(summary_lines(ds))
+    assert carried.applied == max_load_factor
+    if max_load_factor < 0.1:
+        assert carried.exceeded is None and "EXCEEDED" not in lines
+        assert carried.held == pytest.approx(max_load_factor, rel=0.05)
+    else:
+        assert 1.0 <= carried.exceeded < 1.5
+        assert carried.held < 0.95 * max_load_factor and carried.peak < max_load_factor
+        assert f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s" in lines
+    assert load_carried(run_case(parse_case(_rod_pushover_case(0.2, 2.0, 1.0, 0.01, duration=2.0)), duration=0.2, progress=False)) is None
