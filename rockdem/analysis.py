@@ -575,6 +575,33 @@ def eta_of(attrs: Mapping[str, Any], block_eta: ArrayLike | None, block: int) ->
     return None
 
 
+FALL_FRACTION = 0.5
+"""A free block has fallen when its centroid dropped by this fraction of its smallest dimension
+(relative to the ground; :func:`fallen_blocks`, and the ``fell`` stop of :mod:`rockdem.stopping`)."""
+
+
+def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
+    """Ids of the free blocks of a rockdem result that have fallen by ``frame`` (default the last):
+    their centroid is lower than at the first frame, relative to the ground's own vertical motion,
+    by more than :data:`FALL_FRACTION` of the block's smallest dimension.
+
+    Uses ``block_position (time, block, xyz)``, ``block_free``, ``vertex_local`` and
+    ``block_vertex_start`` (the smallest extent of each block in its body frame), the ``gravity``
+    attribute (default -z) and ``ground_displacement (time, xyz)`` when present.
+    """
+    free = np.flatnonzero(np.asarray(ds["block_free"].values, dtype=bool))
+    g = np.asarray(ds.attrs.get("gravity", (0.0, 0.0, -9.81)), dtype=float).reshape(3)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    start = np.asarray(ds["block_vertex_start"].values, dtype=np.int64)
+    v = np.asarray(ds["vertex_local"].values, dtype=float)
+    thickness = np.array([float(np.ptp(v[start[b]:start[b + 1]], axis=0).min()) for b in free])
+    pos = np.asarray(ds["block_position"].values, dtype=float)
+    drop = (pos[0, free] - pos[frame, free]) @ up
+    if "ground_displacement" in ds:
+        drop = drop + float(np.asarray(ds["ground_displacement"].values[frame], dtype=float) @ up)
+    return free[drop > FALL_FRACTION * thickness]
+
+
 def is_pushover(ds: Any) -> bool:
     """Whether a result is a pushover (a ``load_factor`` variable or the ``pushover_*`` attributes
     that :func:`rockdem.loading.pushover` and the TOML pushover loadings write)."""

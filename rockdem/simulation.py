@@ -344,7 +344,8 @@ def run_model(
         elif sunk is not None:
             t_now = float(state.time[0])
             block, what = sunk
-            msg = f"the run stopped at t = {t_now:.4g} s (step {int(state.step[0])}): {what}; the result holds the frames computed"
+            when = f"t = {t_now:.4g} s" if t_now <= duration else f"its end (its last step reached t = {t_now:.4g} s)"
+            msg = f"the run stopped at {when} (step {int(state.step[0])}): {what}; the result holds the frames computed"
             attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                           "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
             warnings.warn(msg, RuntimeWarning, stacklevel=2)
@@ -450,7 +451,10 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
             raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
                              f"the options it was started with; leave {name} unset")
     if not duration > ck.time:
-        raise ValueError(f"the checkpoint is already at t = {ck.time:.6g} s: give a duration (the end time) beyond it")
+        last = float(ck.records.time[ck.frame - 1]) if ck.frame else ck.time
+        raise ValueError(f"nothing is left to compute: the checkpoint's run already reached t = {last:.6g} s (its last frame; "
+                         f"the state is at {ck.time:.6g} s), and the end asked for is {duration:.6g} s; to run on, give a "
+                         "later end time (--duration or [run] duration)")
     _check_step_count(ck.timestep, duration - ck.time, max_steps)
     state, scratch = ck.engine_arrays(model)
     rec = _frames(model, duration, ck.record_interval)

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from .analysis import FALL_FRACTION
 from .kernels.rotation import quats_to_matrices, rotation_vector
 from .model import Model
 from .results import block_thickness, ground_blocks, rocking_pivots
@@ -92,9 +93,6 @@ sqrt(g d), d the block's smallest dimension (1.4 mm/s for d = 0.2 m)."""
 INPUT_ZERO = 1e-9
 """Input samples below this fraction of the table's largest value (accelerations: at least 1 m/s^2)
 count as zero (a record's last sample is zero up to rounding)."""
-
-FALL_FRACTION = 0.5
-"""A free block has fallen when its centroid dropped by this fraction of its smallest dimension."""
 
 
 @dataclass(frozen=True)

@@ -287,3 +287,27 @@ def test_threads_option(tmp_path, capsys):
     assert main(["run", "--example", "free-rocking", "--out", str(tmp_path / "u"), "--threads", too_many, "--quiet"]) == 2
     err = capsys.readouterr().err
     assert "NUMBA_NUM_THREADS" in err and "Traceback" not in err
+
+
+def test_a_run_cut_by_its_last_step_says_so():
+    # A block on joints far too soft (kn = 3e4 Pa/m) sinks; the check after its last chunk finds it
+    # with the state a step past the 0.2 s end (the timestep is several hundredths of a second).
+    # The message and the summary say "at its end", not a time past the run's duration.
+    import warnings
+
+    from rockdem.materials import JointMaterial
+    from rockdem.model import ModelBuilder
+    from rockdem.run_cli import summary_lines
+    from rockdem.simulation import simulate
+
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=3e4, friction_angle=30.0)
+    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.2, 1, 1, density=1800, name="block")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = simulate(b.finalize(), 0.2, progress=False)
+    t_bad = ds.attrs["diverged_time"]
+    assert ds.attrs["diverged_reason"] == "sank" and t_bad > 0.2
+    assert f"the run stopped at its end (its last step reached t = {t_bad:.4g} s)" in ds.attrs["diverged_message"]
+    assert f"DIVERGED at the end of the run (its last step reached t = {t_bad:.4g} s)" in "\n".join(summary_lines(ds))
