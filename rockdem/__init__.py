@@ -4,7 +4,8 @@ The main API is importable from the package root (loaded on first use, so ``impo
 fast): ``ModelBuilder``, ``Damping``, ``Motion``, ``JointMaterial``, ``box``, ``convex_hull``,
 ``simulate``, ``save``, ``load``, the specimen builders (``stacked_blocks``, ``brick_wall``,
 ``parapet``, ``facade``, ``two_block_wall``), loading (``apply_earthquake``, ``pushover``,
-``apply_rod_pushover``, ``capacity_curve``, ``read_record``), ``advise``, ``summarize_result``,
+``apply_rod_pushover``, ``capacity_curve``, ``load_carried``, ``read_record``), ``advise``,
+``summarize_result``, ``fallen_blocks``,
 ``housner_rock``, automatic SP damping (``critical_betas``, ``RestitutionTarget``; ``Damping(beta="auto")``
 and ``Damping(beta="critical")``), case files (``load_case``, ``parse_case``, ``run_case``) and studies
 (``RunSpec``, ``execute``, ``calibrate``, ``run_ida``).
@@ -24,8 +25,8 @@ _API = {
     "stacked_blocks": "specimens", "brick_wall": "specimens", "parapet": "specimens",
     "facade": "specimens", "two_block_wall": "specimens",
     "apply_earthquake": "loading", "pushover": "loading", "apply_rod_pushover": "loading",
-    "capacity_curve": "loading", "read_record": "records",
-    "advise": "advisor", "summarize_result": "analysis",
+    "capacity_curve": "loading", "load_carried": "loading", "read_record": "records",
+    "advise": "advisor", "summarize_result": "analysis", "fallen_blocks": "analysis",
     "critical_betas": "interfaces", "RestitutionTarget": "beta_choice",
     "load_case": "case", "parse_case": "case", "run_case": "run_cli",
     "RunSpec": "studies", "execute": "studies", "calibrate": "calibration", "run_ida": "fragility",

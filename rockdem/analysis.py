@@ -44,6 +44,8 @@ __all__ = [
     "lowest_vertex_height",
     "result_eta",
     "eta_of",
+    "FALL_FRACTION",
+    "fallen_blocks",
     "is_free_rocking",
     "is_pushover",
     "summarize_result",

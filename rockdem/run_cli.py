@@ -139,7 +139,7 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             if var in ds:
                 failed = int(ds[var].values[-1])
                 lines.append(_row(f"failed in {mode}", f"{failed}", "", f"{100 * failed / npts:.1f} % of {npts} sub-contacts"))
-        if len(free) > 1:
+        if len(free) > 1 and all(v in ds for v in ("block_position", "vertex_local", "block_vertex_start")):
             fallen = fallen_blocks(ds)
             lines.append(_row("fallen blocks", f"{fallen.size}", "",
                               f"of {len(free)}: centroid dropped by over {FALL_FRACTION:g} of its smallest dimension"
