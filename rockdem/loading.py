@@ -542,7 +542,9 @@ class LoadCarried(NamedTuple):
         peak: largest load factor of the base reaction, lambda = -R.d / W [-].
         peak_time: its time [s].
         applied: the applied load factor at the last frame [-].
-        held: the base reaction's load factor averaged over the last ``window`` seconds [-].
+        held: the load factor the base carries at the end, without its ringing: ``applied``
+            less the reaction's shortfall from the applied load averaged over the last ``window``
+            seconds [-].
         window: that averaging time [s] (:data:`EQUILIBRIUM_WINDOW` of the run).
         exceeded: time [s] from which the reaction, averaged over the frames before it
             (:data:`EQUILIBRIUM_WINDOW`), stays short of the applied load by more than
@@ -581,7 +583,7 @@ def load_carried(ds: xr.Dataset) -> LoadCarried | None:
         held = np.flatnonzero(~short)
         exceeded = float(t[held[-1] + 1]) if held.size else float(t[0])
     k = int(np.argmax(reaction))
-    held = float(np.mean(reaction[-w:]))
+    held = float(applied[-1] - shortfall[-1])
     return LoadCarried(float(reaction[k]), float(t[k]), float(applied[-1]), held, float(t[-1] - t[-w]), exceeded)
 
 

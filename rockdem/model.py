@@ -939,8 +939,8 @@ PLAUSIBLE_FRICTION_ANGLE = 3.0  # [deg] below this a friction angle is likely a 
 
 
 OVERDAMPED_BETA = 10.0
-"""A numeric beta this many times the largest critical value 2 / omega of the model's joints is
-warned about (DeJong's beta, paper §2.2, is the critical one)."""
+"""A numeric beta this many times the critical value 2 / omega of the model's slowest impact is
+warned about (:func:`_warn_implausible_damping`; DeJong's beta, paper §2.2, is a critical one)."""
 
 
 def _warn_implausible_damping(model: Model, damping: Damping) -> None:
@@ -951,8 +951,9 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
       velocities decaying within 1 / alpha (the paper's MP values are 0.05 to 1 1/s).
     * a numeric beta [s] above :data:`OVERDAMPED_BETA` times the largest critical beta 2 / omega,
       omega = sqrt(kn A / m) of a free block on its smallest face (its two smallest extents: the
-      slowest of its impacts, DeJong's omega_e of a block standing on its base) and softest joint: every impact is over-damped that many times, and a block settles into
-      its joint over about beta seconds instead of bouncing.
+      slowest of its impacts, DeJong's omega_e of a block standing on its base) and softest
+      joint: every impact is over-damped that many times, and a block settles into its joint
+      over about beta seconds instead of bouncing.
     """
     m = model.arrays
     free = np.flatnonzero(m.block_free)

@@ -108,6 +108,7 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
                 label, value = pair.split(": ", 1)
                 lines.append(_row(f"beta {label}", value.split(" s ")[0], "s", value.split(" s ", 1)[-1].strip("()")))
     free = np.flatnonzero(ds.block_free.values)
+    carried = load_carried(ds) if n else None  # a load-controlled pushover's base reaction
     b = peak_block = int(free[0]) if len(free) else 0
     if n and len(free):
         theta = np.abs(ds.rocking_angle.values[:, free])
@@ -129,10 +130,10 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             # impact), so it depends on where the frames fall
             lines.append(_row("energy balance error", f"{err:.2e}", "",
                               f"largest, relative (at impacts: depends on the frame times); at the end {float(errors[-1]):.2e}"))
-        carried = load_carried(ds)
         if carried is not None:
-            lines.append(_row("load factor carried", f"{carried.peak:.4g}", "",
-                              f"peak of base reaction / weight (with its ringing), at t = {carried.peak_time:.4g} s; applied at the end {carried.applied:.4g}"))
+            lines.append(_row("load factor carried", f"{carried.held:.4g}", "",
+                              f"base reaction / weight at the end, its ringing averaged over {carried.window:.3g} s (applied {carried.applied:.4g}); "
+                              f"peak {carried.peak:.4g} at t = {carried.peak_time:.4g} s, with its ringing"))
         npts = max(int(a.get("point_count", 1)), 1)
         for mode in ("shear", "tension"):
             var = f"contacts_failed_{mode}"
@@ -161,10 +162,9 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         what = {"overturned": f"block {a.get('stop_block')!r} overturned", "fell": f"block {a.get('stop_block')!r} fell",
                 "rest": "at rest after the input"}.get(a["stop_reason"], a["stop_reason"])
         lines.append(f"STOPPED at t = {a['stop_time']:.4g} s: {what} (stop = {a.get('stop_rule')!r}); the outcome was decided")
-    carried = load_carried(ds) if n else None
     if carried is not None and carried.exceeded is not None:
         lines.append(f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s: the base reaction carries "
-                     f"{carried.held:.4g} of the applied load factor {carried.applied:.4g} (mean of the last {carried.window:.3g} s) "
+                     f"{carried.held:.4g} of the applied load factor {carried.applied:.4g} (its ringing averaged over {carried.window:.3g} s) "
                      "and the rest accelerates the specimen; the ramp's curve past that time is not a capacity "
                      "(follow the softening branch with [loading] mode = \"displacement\")")
     if a.get("diverged"):
