@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .case import Table, loading
 from .geometry import box, mass_properties
+from .analysis import fallen_blocks
 from .model import GROUND, Damping, ModelBuilder, Motion
 from .records import STANDARD_GRAVITY, GroundMotion, read_record, record_path
 from .simulation import Monitor, simulate
@@ -528,7 +529,7 @@ def capacity_curve(
 EQUILIBRIUM_TOLERANCE = 0.05
 """A load-controlled pushover is out of static equilibrium where the base reaction, averaged over
 :data:`EQUILIBRIUM_WINDOW` of the run, falls short of the applied load by more than this share of
-it (the rest accelerates the specimen)."""
+the largest applied load (the rest accelerates the specimen)."""
 
 EQUILIBRIUM_WINDOW = 0.1
 """Share of the run (at least 3 frames) over which the base reaction is averaged for that test:
@@ -536,55 +537,73 @@ impacts of the base's points make it ring by +-10 %, the shortfall that moves th
 
 
 class LoadCarried(NamedTuple):
-    """What a load-controlled pushover's specimen carried (:func:`load_carried`).
+    """What a load-controlled pushover's specimen carried (:func:`load_carried`). Load factors
+    lambda are forces over the weight of the free blocks [-]; times in s.
 
     Attributes:
-        peak: largest load factor of the base reaction, lambda = -R.d / W [-].
-        peak_time: its time [s].
-        applied: the applied load factor at the last frame [-].
-        held: the load factor the base carries at the end, without its ringing: ``applied``
-            less the reaction's shortfall from the applied load averaged over the last ``window``
-            seconds [-].
-        window: that averaging time [s] (:data:`EQUILIBRIUM_WINDOW` of the run).
-        exceeded: time [s] from which the reaction, averaged over the frames before it
-            (:data:`EQUILIBRIUM_WINDOW`), stays short of the applied load by more than
-            :data:`EQUILIBRIUM_TOLERANCE` of it to the end (the load exceeded what the specimen
-            carries and it accelerates), or None when it ends in equilibrium.
+        peak: largest lambda of the base reaction (-R.d / W), with its ringing.
+        peak_time: its time.
+        applied: the applied lambda at the last frame.
+        carried: the base reaction's lambda averaged over the last ``window`` seconds.
+        applied_mean: the applied lambda averaged over the same frames.
+        window: that averaging time (:data:`EQUILIBRIUM_WINDOW` of the run).
+        lag: the first time the reaction, averaged over ``window`` around it, falls short of the
+            applied load by more than :data:`EQUILIBRIUM_TOLERANCE` of the largest applied load
+            (the rest accelerates the specimen), or None.
+        exceeded: ``lag`` when the load exceeded what the specimen carries: the shortfall lasts
+            to the end while the monitor moves on to its largest displacement, or a block
+            overturned (rotated past its eta) or fell; else None.
+        too_fast: ``lag`` otherwise (the shortfall is gone by the end, or the specimen swings
+            back, and nothing overturned): the ramp was too fast for a quasi-static response;
+            else None.
     """
 
     peak: float
     peak_time: float
     applied: float
-    held: float
+    carried: float
+    applied_mean: float
     window: float
+    lag: float | None
     exceeded: float | None
+    too_fast: float | None
 
 
 def load_carried(ds: xr.Dataset) -> LoadCarried | None:
     """The base reaction of a load-controlled pushover against its applied ramp (None for another
-    result): a ramp that passes the specimen's capacity reads as carried on the ramp's own curve,
-    while the specimen is accelerating, out of equilibrium, from where the reaction falls behind."""
+    result). A ramp past the specimen's capacity reads as carried on the ramp's own curve while
+    the specimen accelerates out of equilibrium (or has overturned); a ramp too fast for the
+    specimen's inertia leaves the reaction behind too, until the ramp stops."""
     a = ds.attrs
     if a.get("pushover_rate") is None or a.get("pushover_rod") is not None or "base_reaction" not in ds or ds.sizes.get("time", 0) < 2:
         return None
-    monitor = str(ds.monitor.values[0]) if ds.sizes.get("monitor", 0) else None
-    if monitor is None:
+    if not ds.sizes.get("monitor", 0):
         return None
-    applied, _ = capacity_curve(ds, monitor, source="ramp")
+    monitor = str(ds.monitor.values[0])
+    applied, disp = capacity_curve(ds, monitor, source="ramp")
     reaction, _ = capacity_curve(ds, monitor, source="reaction")
     t = ds.time.values
     w = max(3, int(round(EQUILIBRIUM_WINDOW * t.size)))
     sums = np.cumsum(np.r_[0.0, applied - reaction])
-    start = np.maximum(np.arange(1, t.size + 1) - w, 0)
-    shortfall = (sums[1:] - sums[start]) / (np.arange(1, t.size + 1) - start)  # trailing mean (T,)
-    short = shortfall > EQUILIBRIUM_TOLERANCE * applied
-    exceeded = None
-    if short[-1]:
-        held = np.flatnonzero(~short)
-        exceeded = float(t[held[-1] + 1]) if held.size else float(t[0])
-    k = int(np.argmax(reaction))
-    held = float(applied[-1] - shortfall[-1])
-    return LoadCarried(float(reaction[k]), float(t[k]), float(applied[-1]), held, float(t[-1] - t[-w]), exceeded)
+    k = np.arange(t.size)
+    lo, hi = np.maximum(k - w // 2, 0), np.minimum(k + w // 2 + 1, t.size)
+    shortfall = (sums[hi] - sums[lo]) / (hi - lo)  # (T,) mean over the window around each frame
+    short = shortfall > EQUILIBRIUM_TOLERANCE * float(np.max(applied))  # a share of the largest load, not of a ramp near 0
+    lag = float(t[np.argmax(short)]) if short.any() else None
+    free = np.flatnonzero(np.asarray(ds.block_free.values, dtype=bool))
+    eta = ds.block_eta.values[free] if "block_eta" in ds else np.full(free.size, np.nan)
+    with np.errstate(invalid="ignore"):
+        overturned = bool(np.any(np.abs(ds.rocking_angle.values[:, free]) > eta)) if "rocking_angle" in ds else False
+    collapsed = overturned or (all(v in ds for v in ("block_position", "vertex_local", "block_vertex_start")) and fallen_blocks(ds).size > 0)
+    tail = slice(t.size - w, t.size)
+    # Running away: short of the load at the end and moving to a new largest displacement (a
+    # ringing specimen after a fast ramp is short at times too, but swings back).
+    running = bool(short[-1]) and t.size > w and disp[-1] > float(np.max(disp[: t.size - w]))
+    exceeded = lag if lag is not None and (running or collapsed) else None
+    too_fast = lag if lag is not None and exceeded is None else None
+    j = int(np.argmax(reaction))
+    return LoadCarried(float(reaction[j]), float(t[j]), float(applied[-1]), float(np.mean(reaction[tail])),
+                       float(np.mean(applied[tail])), float(t[-1] - t[-w]), lag, exceeded, too_fast)
 
 
 def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: str) -> NDArray[np.float64]:
@@ -630,8 +649,15 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
     columns = tuple(t.integer(key) if key in t.data else None for key in ("time_column", "acc_column"))
     gm = _read_table_record(t, "record", units, dt, columns)
     vert = t.raw("vertical", False)
+    vcol = t.integer("vertical_column") if "vertical_column" in t.data else None
+    if vcol is not None and not isinstance(vert, str):
+        raise ValueError(f"[{t.where}] vertical_column is the column of the vertical record: give vertical = \"FILE\" too")
     if isinstance(vert, str):
-        gv = read_record(vert, units=units, dt=dt, time_column=columns[0], acc_column=columns[1])
+        same = record_path(vert).resolve() == record_path(t.string("record")).resolve()
+        if same and vcol is None:
+            raise ValueError(f"[{t.where}] vertical is the record's own file: give vertical_column, the zero-based column of "
+                             "the vertical acceleration (the horizontal's is acc_column)")
+        gv = read_record(vert, units=units, dt=dt, time_column=columns[0], acc_column=columns[1] if vcol is None else vcol)
         n = min(gv.npts, gm.npts)
         if abs(gv.dt - gm.dt) > 1e-9 * gm.dt:
             raise ValueError(f"[{t.where}] vertical record dt {gv.dt} s differs from the record's {gm.dt} s")
@@ -682,16 +708,15 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
     (scale to this PGA [g]), direction (default [1, 0, 0]), vertical (false, or a record file of
     the vertical acceleration in the same units and dt), mode ("foundation" or "inertial"),
     baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0, before
-    the run's end), time_column and acc_column (zero-based columns of a time/acceleration file
-    with more than two columns; defaults 0 and 1).
+    the run's end: :func:`rockdem.run_cli.run_options`), time_column and acc_column (zero-based
+    columns of a time/acceleration file with more than two columns; defaults 0 and 1),
+    vertical_column (the vertical record's acceleration column; required when vertical is the
+    record's own file).
     """
     settings = _earthquake_settings(t)
-    duration = ctx["run"].duration
-    if settings["delay"] >= duration:
-        raise ValueError(f"[{t.where}] delay = {settings['delay']:g} s is not before the run's end (run.duration = "
-                         f"{duration:g} s): the record would never act; shorten the delay or lengthen the run")
     info = apply_earthquake(b, **settings)
     ctx["attrs"].update(
+        earthquake_delay_s=settings["delay"],  # checked against the run's end (run_cli.run_options)
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,
         earthquake_pga_m_s2=info.pga,

@@ -946,9 +946,10 @@ warned about (:func:`_warn_implausible_damping`; DeJong's beta, paper §2.2, is 
 def _warn_implausible_damping(model: Model, damping: Damping) -> None:
     """Warn about Rayleigh coefficients that over-damp every motion of the model.
 
-    * alpha [1/s] above 2 sqrt(g / d), d the smallest dimension of the free blocks: critical damping
-      of the fastest motion gravity drives (a pendulum of length d); under it blocks creep, their
-      velocities decaying within 1 / alpha (the paper's MP values are 0.05 to 1 1/s).
+    * alpha [1/s] above 2 p, p = sqrt(3 g / 4 R) the rocking frequency parameter of the slowest
+      free block (Housner's, of a rectangular block; R its half diagonal across its thickness and
+      height, its smallest and largest extents): MP damping then over-damps its rocking, which
+      creeps instead of swinging (the paper's MP values are 0.05 to 1 1/s).
     * a numeric beta [s] above :data:`OVERDAMPED_BETA` times the largest critical beta 2 / omega,
       omega = sqrt(kn A / m) of a free block on its smallest face (its two smallest extents: the
       slowest of its impacts, DeJong's omega_e of a block standing on its base) and softest
@@ -962,12 +963,14 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
         return
     start = m.block_vertex_start
     extents = np.array([np.sort(np.ptp(m.vertex_local[start[b]:start[b + 1]], axis=0)) for b in free])  # (nf, 3) ascending
-    smallest = float(extents[:, 0].min())
-    if g > 0.0 and damping.alpha > 2.0 * math.sqrt(g / smallest):
+    radius = 0.5 * np.hypot(extents[:, 0], extents[:, 2])  # (nf,) half diagonal [m]
+    slowest = int(np.argmax(radius))
+    p = math.sqrt(0.75 * g / float(radius[slowest]))
+    if g > 0.0 and damping.alpha > 2.0 * p:
         warnings.warn(
-            f"damping.alpha = {damping.alpha:g} 1/s over-damps every motion of the blocks: it is above "
-            f"2 sqrt(g / d) = {2.0 * math.sqrt(g / smallest):.3g} 1/s (critical for a pendulum of the smallest block "
-            f"dimension d = {smallest:g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
+            f"damping.alpha = {damping.alpha:g} 1/s over-damps the rocking of block {model.block_names[int(free[slowest])]!r}: "
+            f"it is above 2 p = {2.0 * p:.3g} 1/s, critical for its rocking frequency p = sqrt(3 g / 4 R) = {p:.3g} rad/s "
+            f"(R = {float(radius[slowest]):.3g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
             "paper's MP values are 0.05 to 1 1/s (alpha = 22.4 beta + 0.05)", UserWarning, stacklevel=3,
         )
     beta = damping.beta

@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import functools
 import hashlib
+import math
 import os
 import re
 import warnings
@@ -389,6 +390,12 @@ _UNITS_RE = re.compile(r"UNITS\s+(?:OF|ARE|IN|:)?\s*\(?\s*([A-Za-z'/^*0-9]+)", r
 _NOT_ACCEL_RE = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b.*\bUNITS?\b", re.IGNORECASE)
 
 
+DT_OVERRIDE_SHARE = 0.02
+"""A dt that overrides an AT2 header's by more than its rounding (half a unit in the header's last
+digit), or by more than this share of it, is warned about: data providers round DT to a few
+digits (``.0029`` for 0.00293 s, 1 %), not by half a sample (``.01`` for 0.0149 s)."""
+
+
 def _half_last_digit(text: str) -> float:
     """Half a unit in the last digit of a number as written (``".0029"``: 5e-5, ``"1.0E-02"``:
     5e-4): how far the value it stands for may be from it by rounding alone."""
@@ -437,8 +444,9 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
         units: units of the values. Default: those the header states ("UNITS OF G", "units are (g)"),
             else g. An explicit value that contradicts the header is an error.
         dt: time step [s] overriding the header's (which some files round, e.g. ``.0029``). A
-            dt farther from the header's than its rounding (half a unit in its last digit) is
-            used, with a warning: it stretches or shrinks the record in time.
+            dt farther from the header's than its rounding (half a unit in its last digit, at
+            most :data:`DT_OVERRIDE_SHARE` of it) is used, with a warning: it stretches or
+            shrinks the record in time.
 
     Returns:
         The record in m/s^2, named after the file stem, with header line 2 as description.
@@ -465,9 +473,10 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
     step = dt_head if dt is None else dt
     if not np.isfinite(step) or step <= 0.0:
         raise ValueError(f"{p}: dt must be positive, got {step!r} (pass dt=... to override the header)")
-    if dt is not None and abs(dt - dt_head) > rounding * (1.0 + 1e-9):
-        warnings.warn(f"{p}: dt = {dt:g} s overrides the header's DT = {dt_head:g} s (line {i_head + 1}), more "
-                      f"than its rounding ({rounding:g} s): the record's {npts * dt_head:g} s become "
+    allowed = min(rounding, DT_OVERRIDE_SHARE * dt_head)
+    if dt is not None and abs(dt - dt_head) > allowed * (1.0 + 1e-9):
+        warnings.warn(f"{p}: dt = {dt:g} s overrides the header's DT = {dt_head:g} s (line {i_head + 1}) by more "
+                      f"than its rounding ({allowed:g} s): the record's {npts * dt_head:g} s become "
                       f"{npts * dt:g} s; omit dt to use the header's", UserWarning, stacklevel=2)
     # NGA files put the event and station on line 2 under a fixed banner; other variants on line 1.
     banner = lines[0].strip().upper().startswith("PEER")
@@ -541,6 +550,10 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
         raise ValueError(f"{p}, line {linenos[j + 1]}: time step {steps[j]!r} s differs from the record's "
                          f"{dt_typ!r} s; rockdem needs a uniform dt (resample the file first)")
     dt = (t[-1] - t[0]) / (t.size - 1)
+    if dt == 1.0 and t[0] in (0.0, 1.0) and np.all(t == np.round(t)):
+        warnings.warn(f"{p}: column {time_column} counts the samples ({t[0]:g}, {t[1]:g}, {t[2] if t.size > 2 else t[1]:g}, ...) "
+                      "rather than giving times: dt = 1 s; if it is an index, give time_column (zero-based) for the "
+                      "column of times", UserWarning, stacklevel=2)
     return GroundMotion.from_samples(acc, dt=dt, units=unit, name=p.stem, source=p,
                                      description=" | ".join(c for c in comments if c), start_time=float(t[0]))
 
@@ -620,12 +633,13 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
         time_column, acc_column: zero-based columns of the time [s] and the acceleration of a
             columns file (defaults 0 and 1); giving either reads the file as columns.
     """
+    if dt is not None and (isinstance(dt, bool) or not isinstance(dt, (int, float, np.floating, np.integer))
+                           or not math.isfinite(dt) or dt <= 0.0):
+        raise ValueError(f"{path}: dt must be a positive time step in seconds (a number), got {dt!r}")
     columns = {"time_column": 0 if time_column is None else time_column, "acc_column": 1 if acc_column is None else acc_column}
     for key, value in columns.items():
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
             raise ValueError(f"{path}: {key} must be a zero-based column index (0, 1, 2, ...), got {value!r}")
-    if columns["time_column"] == columns["acc_column"]:
-        raise ValueError(f"{path}: time_column and acc_column are both {columns['acc_column']}; give two different columns")
     chosen = time_column is not None or acc_column is not None
     found = record_path(path)
     if units is None and (entry := _shipped_entry(found)) is not None:
@@ -635,13 +649,18 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
         raise ValueError(f"{p}: unknown format {format!r}; use 'at2', 'columns' or 'single' (or omit it)")
     if format is not None:
         fmt = RecordFormat(str(format).lower())
-    elif chosen:  # columns chosen: a columns file of any width, unless it is an AT2 file
-        fmt = RecordFormat.AT2 if _is_at2(p, lines) else RecordFormat.COLUMNS
+    elif chosen:  # columns chosen: a columns file of any width, unless it is an AT2 or one-column file
+        try:
+            fmt = _sniff_format(p, lines)
+        except ValueError:  # three columns or more
+            fmt = RecordFormat.COLUMNS
     else:
         fmt = _sniff_format(p, lines)
     if chosen and fmt is not RecordFormat.COLUMNS:
         raise ValueError(f"{p}: time_column and acc_column choose the columns of a time/acceleration file, "
                          f"and do not apply to the {fmt.value} format; leave them out")
+    if fmt is RecordFormat.COLUMNS and columns["time_column"] == columns["acc_column"]:
+        raise ValueError(f"{p}: time_column and acc_column are both {columns['acc_column']}; give two different columns")
     if fmt is RecordFormat.AT2:
         return read_at2(p, units=units, dt=dt)
     if units is None:

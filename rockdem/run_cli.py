@@ -18,7 +18,7 @@ from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, positive_int, stop_on_signals
 from .analysis import FALL_FRACTION, fallen_blocks
-from .loading import load_carried
+from .loading import EQUILIBRIUM_TOLERANCE, load_carried
 from .results import export_csv, save, write_contact_table
 from .simulation import _deferred_signals, simulate
 from .stopping import STOP_MODES
@@ -55,11 +55,16 @@ def run_case(
 
 def run_options(case: Case, duration: float | None = None) -> dict[str, Any]:
     """The :func:`rockdem.simulation.simulate` arguments of a case (``duration`` overrides
-    [run] duration), checked: the record interval must not exceed the simulated time."""
+    [run] duration), checked: the record interval must not exceed the simulated time, and a
+    delayed earthquake must start before the run ends."""
     r = case.run
     dur = duration if duration is not None else r.duration
     if r.record_interval > dur:
         raise ValueError(f"[run] record_interval ({r.record_interval:g} s) exceeds the simulated time ({dur:g} s); lower it")
+    delay = float(case.attrs.get("earthquake_delay_s", 0.0))
+    if delay > 0.0 and delay >= dur:
+        raise ValueError(f"[loading] delay = {delay:g} s is not before the run's end ({dur:g} s, [run] duration or "
+                         "--duration): the record would never act; shorten the delay or lengthen the run")
     return {"duration": dur, "dt": r.dt, "timestep_rule": r.timestep_rule, "safety": r.safety, "resolution": r.resolution,
             "dashpots": r.dashpots, "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
             "stop": r.stop}
@@ -131,9 +136,9 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             lines.append(_row("energy balance error", f"{err:.2e}", "",
                               f"largest, relative (at impacts: depends on the frame times); at the end {float(errors[-1]):.2e}"))
         if carried is not None:
-            lines.append(_row("load factor carried", f"{carried.held:.4g}", "",
-                              f"base reaction / weight at the end, its ringing averaged over {carried.window:.3g} s (applied {carried.applied:.4g}); "
-                              f"peak {carried.peak:.4g} at t = {carried.peak_time:.4g} s, with its ringing"))
+            lines.append(_row("load factor carried", f"{carried.carried:.4g}", "",
+                              f"base reaction / weight, mean of the last {carried.window:.3g} s (applied {carried.applied_mean:.4g} "
+                              f"there); peak {carried.peak:.4g} at t = {carried.peak_time:.4g} s, with its ringing"))
         npts = max(int(a.get("point_count", 1)), 1)
         for mode in ("shear", "tension"):
             var = f"contacts_failed_{mode}"
@@ -141,10 +146,12 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
                 failed = int(ds[var].values[-1])
                 lines.append(_row(f"failed in {mode}", f"{failed}", "", f"{100 * failed / npts:.1f} % of {npts} sub-contacts"))
         if len(free) > 1 and all(v in ds for v in ("block_position", "vertex_local", "block_vertex_start")):
-            fallen = fallen_blocks(ds)
-            lines.append(_row("fallen blocks", f"{fallen.size}", "",
-                              f"of {len(free)}: centroid dropped by over {FALL_FRACTION:g} of its smallest dimension"
-                              + (f" ({', '.join(str(x) for x in ds.block_name.values[fallen[:3]])}{', ...' if fallen.size > 3 else ''})" if fallen.size else "")))
+            lines.append(_blocks_row("fallen blocks", ds, fallen_blocks(ds), len(free),
+                                     f"centroid dropped by over {FALL_FRACTION:g} of its smallest dimension"))
+        if len(free) > 1 and "block_eta" in ds:
+            with np.errstate(invalid="ignore"):
+                tipped = free[np.abs(ds.rocking_angle.values[-1, free]) > ds.block_eta.values[free]]
+            lines.append(_blocks_row("blocks past their eta", ds, tipped, len(free), "at the end, each about its own base"))
         if int(a.get("tilted_blocks", 0)) > 1:
             # a released assembly (e.g. a discretised wall): analyse a block of its base course
             z0 = ds.block_position.values[0, free, 2]
@@ -163,17 +170,28 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
                 "rest": "at rest after the input"}.get(a["stop_reason"], a["stop_reason"])
         lines.append(f"STOPPED at t = {a['stop_time']:.4g} s: {what} (stop = {a.get('stop_rule')!r}); the outcome was decided")
     if carried is not None and carried.exceeded is not None:
-        lines.append(f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s: the base reaction carries "
-                     f"{carried.held:.4g} of the applied load factor {carried.applied:.4g} (its ringing averaged over {carried.window:.3g} s) "
-                     "and the rest accelerates the specimen; the ramp's curve past that time is not a capacity "
+        lines.append(f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s: the base reaction fell behind the applied "
+                     "load and the specimen accelerated (or overturned); the ramp's curve past that time is not a capacity "
                      "(follow the softening branch with [loading] mode = \"displacement\")")
+    elif carried is not None and carried.too_fast is not None:
+        lines.append(f"NOT QUASI-STATIC from t = {carried.too_fast:.4g} s: the base reaction fell behind the ramp by more than "
+                     f"{EQUILIBRIUM_TOLERANCE:.0%} and caught up only after it; the ramp is too fast for the specimen's "
+                     "inertia (lower [loading] rate)")
     if a.get("diverged"):
         t_bad, end = float(a["diverged_time"]), float(a.get("duration", np.inf))
         when = f"t = {t_bad:.4g} s" if t_bad <= end else f"the end of the run (its last step reached t = {t_bad:.4g} s)"
-        lines.append(f"DIVERGED at {when}: the result holds the sound frames before it")
+        held = ("the frames up to it, the last ones already sinking" if a.get("diverged_reason") == "sank"
+                else "the sound frames before it")
+        lines.append(f"DIVERGED at {when}: the result holds {held}")
     if a.get("interrupted"):
         lines.append("INTERRUPTED: the result holds the frames computed before the interruption")
     return lines
+
+
+def _blocks_row(label: str, ds: xr.Dataset, blocks: np.ndarray, of: int, what: str) -> str:
+    """A summary row counting ``blocks`` (ids) of ``of`` free blocks, naming the first three."""
+    names = ", ".join(str(x) for x in ds.block_name.values[blocks[:3]]) + (", ..." if blocks.size > 3 else "")
+    return _row(label, f"{blocks.size}", "", f"of {of}: {what}" + (f" ({names})" if blocks.size else ""))
 
 
 def _axis(attrs: Any) -> str:

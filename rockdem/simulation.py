@@ -253,7 +253,10 @@ def run_model(
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
     thickness = block_thickness(model)
-    chunk = 200 * info.dt  # simulated seconds per compiled call, adapted to ~0.25 s of wall time
+    # Simulated seconds per compiled call, adapted to ~0.25 s of wall time, at most SINK_CHECK_SHARE
+    # of the run: a block sinking into soft joints is found between calls (_sunk).
+    longest = max(SINK_CHECK_SHARE * (duration - float(state.time[0])), info.dt)
+    chunk = min(200 * info.dt, longest)
     stopper = Stopper(model, rule, run.record_interval) if rule is not None else None
     decision: Decision | None = None
     # With a stop rule, chunks of check_steps steps: ``target`` is the time the current chunk ends at
@@ -294,7 +297,7 @@ def run_model(
                     target = target if t_stop == t_end < target else None
                     decision = stopper.check(rec, frame)
             if stopper is None:
-                chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)))
+                chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)), longest)
             saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0, target)
             if bar is None and (progress or (progress is None and _time.perf_counter() - wall0 > 2.0)):
                 bar = _progress_bar(duration, run.start_time)
@@ -450,11 +453,12 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
         if value is not None and value != saved:
             raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
                              f"the options it was started with; leave {name} unset")
-    if not duration > ck.time:
-        last = float(ck.records.time[ck.frame - 1]) if ck.frame else ck.time
-        raise ValueError(f"nothing is left to compute: the checkpoint's run already reached t = {last:.6g} s (its last frame; "
-                         f"the state is at {ck.time:.6g} s), and the end asked for is {duration:.6g} s; to run on, give a "
-                         "later end time (--duration or [run] duration)")
+    frames = int(math.floor(duration / ck.record_interval + 1e-9)) + 1  # as _frames counts them
+    if frames <= ck.frame:
+        last = float(ck.records.time[ck.frame - 1]) if ck.frame else 0.0
+        raise ValueError(f"nothing is left to compute: the checkpoint's run already recorded its frames up to t = {last:.6g} s "
+                         f"(every {ck.record_interval:g} s), and a run to {duration:.6g} s records no later one; to run on, give "
+                         f"an end time of at least {last + ck.record_interval:.6g} s (--duration or [run] duration)")
     _check_step_count(ck.timestep, duration - ck.time, max_steps)
     state, scratch = ck.engine_arrays(model)
     rec = _frames(model, duration, ck.record_interval)
@@ -535,6 +539,10 @@ def _deferred_signals(finishing: bool = False) -> Iterator[None]:
 SINK_FRACTION = 0.25
 """A run stops when a sub-contact's overlap exceeds this fraction of the thinner of its two blocks:
 the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
+
+
+SINK_CHECK_SHARE = 0.05
+"""The sinking check (:func:`_sunk`) runs at least this often, as a share of the run's time."""
 
 
 def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | None:

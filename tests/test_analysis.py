@@ -302,3 +302,4 @@ def test_a_block_falling_off_a_stack_is_counted_as_fallen():
     text = "\n".join(summary_lines(ds))
     assert re.search(r"fallen blocks +1 +of 2: .*\(top\)", text)
     assert re.search(r"analysed block +top +the largest rotation; its eta and overturning are its own", text)
+    assert re.search(r"blocks past their eta +0 +of 2: at the end", text)  # it landed on a face

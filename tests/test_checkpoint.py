@@ -100,10 +100,14 @@ def test_checkpoint_refuses_another_model_or_other_options(case, tmp_path):
         simulate(taller, 0.2, initial=Checkpoint.load(tmp_path / "c.npz").reset_clock(), progress=False)
     with pytest.raises(ValueError, match="record_interval = 0.02 differs"):
         simulate(case.model, 0.2, initial=tmp_path / "c.npz", record_interval=0.02, progress=False)
-    # a finished run: its last frame is at its end, 0.1 s; the state is a step past it
-    for end in (0.05, 0.1):
-        with pytest.raises(ValueError, match=rf"already reached t = 0.1 s \(its last frame.*end asked for is {end} s"):
+    # a finished run: its last frame is at its end, 0.1 s (the state a step past it); an end that
+    # records no later frame is refused with the first end time that does
+    interval = Checkpoint.load(tmp_path / "c.npz").record_interval
+    for end in (0.05, 0.1, 0.1 + 0.5 * interval):
+        with pytest.raises(ValueError, match=rf"frames up to t = 0.1 s .*a run to {end:.6g} s records no later one.*"
+                                             rf"at least {0.1 + interval:.6g} s"):
             simulate(case.model, end, initial=tmp_path / "c.npz", progress=False)
+    assert simulate(case.model, 0.1 + interval, initial=tmp_path / "c.npz", progress=False).time.values[-1] == pytest.approx(0.1 + interval)
 
 
 def test_checkpoint_of_another_engine_layout_is_refused_by_name(case, tmp_path):
