@@ -9,6 +9,7 @@ in :data:`LOADINGS`. Units: SI, angles in degrees where the key says ``_deg``.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import math
 import os
@@ -632,9 +633,10 @@ class CaseTemplate:
         if self._swap:
             builder, monitors = copy.copy(self._bare), dict(self._monitors)
             ctx = _loading(top, builder, monitors, run)
-            if tuple(ctx.get("rocking_axis", (0.0, 1.0, 0.0))) != tuple(self._ctx.get("rocking_axis", (0.0, 1.0, 0.0))):
-                raise ValueError("CaseTemplate.derive: the loading changed the rocking axis")
             model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
+            axis = np.asarray(ctx.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)
+            if not np.array_equal(axis / np.linalg.norm(axis), model.rocking_axis):  # a load along another direction
+                model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
         else:
             top.used.add("loading")
             ctx, monitors = self._ctx, dict(self.case.monitors)

@@ -64,6 +64,7 @@ __all__ = [
     "apply_rod_pushover",
     "rigid_rod_load_factor",
     "pushover",
+    "rocking_axis_of",
     "load_carried",
     "LoadCarried",
     "capacity_curve",
@@ -550,9 +551,11 @@ class LoadCarried(NamedTuple):
         lag: the first time the reaction, averaged over ``window`` around it, falls short of the
             applied load by more than :data:`EQUILIBRIUM_TOLERANCE` of the largest applied load
             (the rest accelerates the specimen), or None.
-        exceeded: ``lag`` when the load exceeded what the specimen carries: the shortfall lasts
-            to the end while the monitor moves on to its largest displacement, or a block
-            overturned (rotated past its eta) or fell; else None.
+        exceeded: when the load exceeded what the specimen carries (the shortfall lasts to the
+            end while the monitor moves on to its largest displacement, or a block overturned,
+            rotated past its eta, or fell): the time from which the reaction stays short of the
+            load by more than :data:`EQUILIBRIUM_TOLERANCE` of the load itself, up to the end or
+            to the largest shortfall; else None.
         too_fast: ``lag`` otherwise (the shortfall is gone by the end, or the specimen swings
             back, and nothing overturned): the ramp was too fast for a quasi-static response;
             else None.
@@ -599,11 +602,28 @@ def load_carried(ds: xr.Dataset) -> LoadCarried | None:
     # Running away: short of the load at the end and moving to a new largest displacement (a
     # ringing specimen after a fast ramp is short at times too, but swings back).
     running = bool(short[-1]) and t.size > w and disp[-1] > float(np.max(disp[: t.size - w]))
-    exceeded = lag if lag is not None and (running or collapsed) else None
+    exceeded = None
+    if lag is not None and (running or collapsed):
+        # Since when: the last time before the shortfall that ends the run (or the collapse) that
+        # the reaction still carried the load within the tolerance of the load itself.
+        end = t.size - 1 if running else int(np.argmax(shortfall))
+        held = np.flatnonzero(shortfall[:end + 1] <= EQUILIBRIUM_TOLERANCE * applied[:end + 1])
+        exceeded = float(t[held[-1] + 1]) if held.size and held[-1] + 1 < t.size else lag
     too_fast = lag if lag is not None and exceeded is None else None
     j = int(np.argmax(reaction))
     return LoadCarried(float(reaction[j]), float(t[j]), float(applied[-1]), float(np.mean(reaction[tail])),
                        float(np.mean(applied[tail])), float(t[-1] - t[-w]), lag, exceeded, too_fast)
+
+
+def rocking_axis_of(direction: ArrayLike, gravity: ArrayLike, what: str = "direction") -> tuple[float, float, float]:
+    """The axis a load along ``direction`` rocks blocks about: up x d, d the horizontal unit
+    direction (so that the rocking direction, rocking_axis x up, is d and a positive
+    ``rocking_angle`` tips blocks along the load); (0, 1, 0) for +x under gravity along -z."""
+    g = np.asarray(gravity, dtype=float).reshape(3)
+    d = _horizontal_unit(direction, g, what)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    axis = np.cross(up, d)
+    return (float(axis[0]) + 0.0, float(axis[1]) + 0.0, float(axis[2]) + 0.0)  # + 0.0: no -0.0
 
 
 def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: str) -> NDArray[np.float64]:
@@ -657,7 +677,16 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
         if same and vcol is None:
             raise ValueError(f"[{t.where}] vertical is the record's own file: give vertical_column, the zero-based column of "
                              "the vertical acceleration (the horizontal's is acc_column)")
-        gv = read_record(vert, units=units, dt=dt, time_column=columns[0], acc_column=columns[1] if vcol is None else vcol)
+        if same and vcol == (1 if columns[1] is None else columns[1]):
+            raise ValueError(f"[{t.where}] vertical_column = {vcol} is the horizontal record's column (acc_column); give "
+                             "the column of the vertical acceleration")
+        # The vertical file's columns: vertical_column, and time_column with it (a layout like the
+        # record's); without vertical_column, read as its format says (a two-column file: 0 and 1).
+        try:
+            gv = read_record(vert, units=units, dt=dt, time_column=columns[0] if vcol is not None else None, acc_column=vcol)
+        except ValueError as exc:
+            raise ValueError(f"[{t.where}] vertical record {vert!r}: {exc} (its acceleration column is vertical_column, "
+                             "its time column time_column)") from exc
         n = min(gv.npts, gm.npts)
         if abs(gv.dt - gm.dt) > 1e-9 * gm.dt:
             raise ValueError(f"[{t.where}] vertical record dt {gv.dt} s differs from the record's {gm.dt} s")
@@ -710,11 +739,12 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
     baseline (true), tail [s] (0), window ([start, end] of the record [s]), delay [s] (0, before
     the run's end: :func:`rockdem.run_cli.run_options`), time_column and acc_column (zero-based
     columns of a time/acceleration file with more than two columns; defaults 0 and 1),
-    vertical_column (the vertical record's acceleration column; required when vertical is the
-    record's own file).
+    vertical_column (the vertical record's acceleration column, needed for a file of more than
+    two columns: the record's own file, or another).
     """
     settings = _earthquake_settings(t)
     info = apply_earthquake(b, **settings)
+    ctx["rocking_axis"] = rocking_axis_of(settings["direction"], b.gravity, f"[{t.where}] direction")
     ctx["attrs"].update(
         earthquake_delay_s=settings["delay"],  # checked against the run's end (run_cli.run_options)
         earthquake_record=info.motion.name,
@@ -738,6 +768,7 @@ def _pushover(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: dict
     """
     mode = t.string("mode", "load", choices=("load", "displacement"))
     direction = t.vector("direction", (1.0, 0.0, 0.0))
+    ctx["rocking_axis"] = rocking_axis_of(direction, b.gravity, f"[{t.where}] direction")
     if mode == "load":
         ramp = apply_pushover(
             b,

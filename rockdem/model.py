@@ -948,8 +948,9 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
 
     * alpha [1/s] above 2 p, p = sqrt(3 g / 4 R) the rocking frequency parameter of the slowest
       free block (Housner's, of a rectangular block; R its half diagonal across its thickness and
-      height, its smallest and largest extents): MP damping then over-damps its rocking, which
-      creeps instead of swinging (the paper's MP values are 0.05 to 1 1/s).
+      height, its smallest and largest extents), or of all the free blocks rocking as one body
+      (R from their extent along the rocking direction and up): MP damping then over-damps that
+      rocking, which creeps instead of swinging (the paper's MP values are 0.05 to 1 1/s).
     * a numeric beta [s] above :data:`OVERDAMPED_BETA` times the largest critical beta 2 / omega,
       omega = sqrt(kn A / m) of a free block on its smallest face (its two smallest extents: the
       slowest of its impacts, DeJong's omega_e of a block standing on its base) and softest
@@ -965,12 +966,25 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
     extents = np.array([np.sort(np.ptp(m.vertex_local[start[b]:start[b + 1]], axis=0)) for b in free])  # (nf, 3) ascending
     radius = 0.5 * np.hypot(extents[:, 0], extents[:, 2])  # (nf,) half diagonal [m]
     slowest = int(np.argmax(radius))
-    p = math.sqrt(0.75 * g / float(radius[slowest]))
+    who, r_max = f"block {model.block_names[int(free[slowest])]!r}", float(radius[slowest])
+    if free.size > 1 and g > 0.0:
+        # The free blocks rocking as one body (a discretised wall): its thickness along the
+        # rocking direction and its height, at the start.
+        from .kernels.rotation import quats_to_matrices
+
+        rot = quats_to_matrices(model.quaternion0[free])
+        world = np.vstack([m.vertex_local[start[b]:start[b + 1]] @ rot[k].T + model.position0[b] for k, b in enumerate(free)])
+        up = -m.gravity / g
+        d = np.cross(model.rocking_axis, up)
+        r_body = 0.5 * math.hypot(float(np.ptp(world @ d)), float(np.ptp(world @ up)))
+        if r_body > r_max:
+            who, r_max = "the free blocks rocking as one body", r_body
+    p = math.sqrt(0.75 * g / r_max) if g > 0.0 else 0.0
     if g > 0.0 and damping.alpha > 2.0 * p:
         warnings.warn(
-            f"damping.alpha = {damping.alpha:g} 1/s over-damps the rocking of block {model.block_names[int(free[slowest])]!r}: "
+            f"damping.alpha = {damping.alpha:g} 1/s over-damps the rocking of {who}: "
             f"it is above 2 p = {2.0 * p:.3g} 1/s, critical for its rocking frequency p = sqrt(3 g / 4 R) = {p:.3g} rad/s "
-            f"(R = {float(radius[slowest]):.3g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
+            f"(R = {r_max:.3g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
             "paper's MP values are 0.05 to 1 1/s (alpha = 22.4 beta + 0.05)", UserWarning, stacklevel=3,
         )
     beta = damping.beta

@@ -673,7 +673,9 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
         return read_single_column(p, dt=dt, units=units)
     gm = read_columns(p, units=units, time_column=int(columns["time_column"]), acc_column=int(columns["acc_column"]))
     if dt is not None and abs(gm.dt - dt) > DT_RTOL * dt:
-        raise ValueError(f"{p}: dt={dt!r} disagrees with the time column's {gm.dt!r} s; omit dt")
+        hint = "; if that column counts samples, give time_column" if gm.dt == 1.0 else ""
+        raise ValueError(f"{p}: dt={dt!r} disagrees with the time column's {gm.dt!r} s (column {columns['time_column']}); "
+                         f"omit dt{hint}")
     return gm
 
 

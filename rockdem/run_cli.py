@@ -136,9 +136,10 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             lines.append(_row("energy balance error", f"{err:.2e}", "",
                               f"largest, relative (at impacts: depends on the frame times); at the end {float(errors[-1]):.2e}"))
         if carried is not None:
+            past = "; past the capacity (below): not a capacity" if carried.exceeded is not None else ""
             lines.append(_row("load factor carried", f"{carried.carried:.4g}", "",
                               f"base reaction / weight, mean of the last {carried.window:.3g} s (applied {carried.applied_mean:.4g} "
-                              f"there); peak {carried.peak:.4g} at t = {carried.peak_time:.4g} s, with its ringing"))
+                              f"there); peak {carried.peak:.4g} at t = {carried.peak_time:.4g} s, with its ringing{past}"))
         npts = max(int(a.get("point_count", 1)), 1)
         for mode in ("shear", "tension"):
             var = f"contacts_failed_{mode}"

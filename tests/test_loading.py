@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rockdem.case import load_case, parse_case
+from rockdem.case import CaseTemplate, load_case, parse_case
 from rockdem.kernels.rotation import quats_to_matrices
 from rockdem.loading import _velocity_table, apply_earthquake, capacity_curve, earthquake_record, load_carried, pushover, resolve_record, rigid_rod_load_factor
 from rockdem.materials import JointMaterial
@@ -289,3 +289,26 @@ def test_a_load_past_the_capacity_is_not_read_as_carried(max_load_factor, rate, 
         assert max_load_factor == 0.2 or carried.peak < max_load_factor  # (0.2: impacts of the fall)
         assert f"LOAD EXCEEDED THE CAPACITY from t = {carried.exceeded:.4g} s" in lines
     assert load_carried(run_case(parse_case(_rod_pushover_case(0.2, 2.0, 1.0, 0.01, duration=2.0)), duration=0.2, progress=False)) is None
+
+
+@pytest.mark.parametrize("loading", [
+    {"type": "pushover", "max_load_factor": 0.1},
+    {"type": "earthquake", "record": "elcentro-rsn6", "window": [0.0, 1.0]},
+])
+def test_a_load_along_y_rocks_the_block_about_x(loading):
+    # A 0.2 (x) x 1.0 (y) x 2.0 m block loaded along y rocks about x over its 1.0 m side: the
+    # result's rocking angle, eta and overturning are about that axis (they were about y, the
+    # x-direction's, whatever the load's direction). The axis is up x d: positive along the load.
+    data = load_case(EXAMPLES / "pushover_0.2x2.0_points2.toml")
+    data["loading"] = {**loading, "direction": [0.0, 1.0, 0.0]}
+    case = parse_case(data)
+    assert tuple(case.model.rocking_axis) == (-1.0, 0.0, 0.0)
+    ds = run_case(case, duration=0.02, progress=False)
+    assert ds.attrs["rocking_axis"] == [-1.0, 0.0, 0.0]
+    assert float(ds.block_eta.values[1]) == pytest.approx(math.atan(1.0 / 2.0), rel=1e-9)
+    data["loading"]["direction"] = [1.0, 0.0, 0.0]
+    assert tuple(parse_case(data).model.rocking_axis) == (0.0, 1.0, 0.0)  # as before for x
+    if loading["type"] == "earthquake":  # a study's template swaps the direction with the record
+        template = CaseTemplate(data)
+        derived = template.derive({**data, "loading": {**data["loading"], "direction": [0.0, -1.0, 0.0]}})
+        assert tuple(derived.model.rocking_axis) == (1.0, 0.0, 0.0)

@@ -482,8 +482,34 @@ def test_a_vertical_component_from_the_records_own_file_needs_its_column(tmp_pat
                         "baseline": False}}
     with pytest.raises(ValueError, match="vertical is the record's own file: give vertical_column"):
         parse_case(case)
+    case["loading"]["vertical_column"] = 1
+    with pytest.raises(ValueError, match="vertical_column = 1 is the horizontal record's column"):
+        parse_case(case)
     case["loading"]["vertical_column"] = 3
     ds = run_case(parse_case(case), progress=False)
     t = ds.time.values
     np.testing.assert_allclose(ds.ground_acceleration.values[:, 0], 10.0 * t * STANDARD_GRAVITY, atol=1e-9)
     np.testing.assert_allclose(ds.ground_acceleration.values[:, 2], -5.0 * t * STANDARD_GRAVITY, atol=1e-9)
+
+
+def test_a_vertical_file_of_another_layout(tmp_path: Path) -> None:
+    """A three-column horizontal file (acc_column = 2) with a vertical of two columns: the vertical
+    is read by its own layout; one of three columns needs vertical_column, named in the error."""
+    from rockdem.case import parse_case
+
+    rows = "\n".join(f"{0.01 * k:.2f}, 9, {0.1 * k:.2f}" for k in range(5))
+    h = _write(tmp_path, "h.csv", rows + "\n")
+    v2 = _write(tmp_path, "v2.csv", "\n".join(f"{0.01 * k:.2f}, {-0.05 * k:.3f}" for k in range(5)) + "\n")
+    v3 = _write(tmp_path, "v3.csv", "\n".join(f"{0.01 * k:.2f}, 9, {-0.05 * k:.3f}" for k in range(5)) + "\n")
+    case = {"run": {"duration": 0.03, "record_interval": 0.01},
+            "specimen": {"type": "block", "width": 0.2, "height": 1.0, "length": 0.5, "youngs_modulus": 1.8e9},
+            "loading": {"type": "earthquake", "record": str(h), "units": "g", "acc_column": 2, "vertical": str(v2), "baseline": False}}
+    gm = parse_case(case).model  # builds: the two-column vertical read as such
+    assert gm.block_count == 2
+    case["loading"]["vertical"] = str(v3)
+    with pytest.raises(ValueError, match=r"vertical record .*v3.csv.*acceleration column is vertical_column"):
+        parse_case(case)
+    case["loading"]["vertical_column"] = 2
+    parse_case(case)
+    with pytest.raises(ValueError, match="omit dt; if that column counts samples, give time_column"):
+        read_record(_write(tmp_path, "i.csv", "0, 0.0, 0.1\n1, 0.01, 0.2\n2, 0.02, 0.3\n"), units="g", acc_column=2, dt=0.01)

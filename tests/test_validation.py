@@ -2,6 +2,7 @@
 
 import math
 import os
+from pathlib import Path
 import warnings
 
 import numpy as np
@@ -309,3 +310,16 @@ def test_a_block_falling_off_the_edge_of_its_foundation_falls_on_and_the_run_com
     # no energy created: kinetic + potential + elastic never exceed the initial energy
     mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
     assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81
+
+
+def test_alpha_that_overdamps_an_assembly_is_warned_about():
+    # The discretised 0.19 x 2.0 m wall rocks as one body (2 p = 5.4 1/s); its bricks alone
+    # would allow 16 1/s. alpha = 10 over-damps the wall's rocking: warned, naming the body.
+    from rockdem.case import apply_overrides, load_case, parse_case
+
+    data = load_case(Path(__file__).resolve().parent.parent / "examples" / "discretised_block_0.19x2.0.toml")
+    with pytest.warns(UserWarning, match=r"alpha = 10 1/s over-damps the rocking of the free blocks rocking as one body: .*2 p = 5.3"):
+        parse_case(apply_overrides(data, ["damping.alpha=10"]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parse_case(apply_overrides(data, ["damping.alpha=1"]))
