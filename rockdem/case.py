@@ -634,9 +634,8 @@ class CaseTemplate:
             builder, monitors = copy.copy(self._bare), dict(self._monitors)
             ctx = _loading(top, builder, monitors, run)
             model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
-            axis = np.asarray(ctx.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)
-            if not np.array_equal(axis / np.linalg.norm(axis), model.rocking_axis):  # a load along another direction
-                model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
+            axis = np.asarray(ctx.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)  # the load's own direction
+            model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
         else:
             top.used.add("loading")
             ctx, monitors = self._ctx, dict(self.case.monitors)

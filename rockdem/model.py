@@ -879,6 +879,18 @@ MAX_MOTION_SAMPLES = 10_000_000
 """Most samples of a prescribed motion built by :meth:`Motion.from_function`."""
 
 
+def _world_vertices(
+    vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64],
+    blocks: Sequence[int] | NDArray[np.int64],
+) -> NDArray[np.float64]:
+    """(V, 3) world vertices [m] of ``blocks`` at centroids ``pos`` (nb, 3) and orientations ``quat``
+    (nb, 4), in block order (each block's ``vstart`` range of ``vertex_local``)."""
+    from .kernels.rotation import quats_to_matrices
+
+    r = quats_to_matrices(quat)
+    return np.vstack([vertex_local[vstart[b] : vstart[b + 1]] @ r[b].T + pos[b] for b in blocks])
+
+
 def _extent(
     vertex_local: NDArray[np.float64], vstart: NDArray[np.int64], pos: NDArray[np.float64], quat: NDArray[np.float64], free: NDArray[np.bool_]
 ) -> dict[str, NDArray[np.float64]]:
@@ -887,10 +899,7 @@ def _extent(
     start (empty when there are none). A free block whose centroid leaves the extent through its
     bottom outside that footprint fell off the edge of the supports and falls on unhindered; one
     leaving it otherwise has fallen through its support or flown away, and the run stops there."""
-    from .kernels.rotation import quats_to_matrices
-
-    r = quats_to_matrices(quat)
-    world = np.vstack([vertex_local[vstart[b] : vstart[b + 1]] @ r[b].T + pos[b] for b in range(len(pos))])
+    world = _world_vertices(vertex_local, vstart, pos, quat, range(len(pos)))
     lo, hi = world.min(axis=0), world.max(axis=0)
     margin = max(float(np.max(hi - lo)), 1.0)
     driven = [b for b in range(len(pos)) if not free[b]]
@@ -970,10 +979,7 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
     if free.size > 1 and g > 0.0:
         # The free blocks rocking as one body (a discretised wall): its thickness along the
         # rocking direction and its height, at the start.
-        from .kernels.rotation import quats_to_matrices
-
-        rot = quats_to_matrices(model.quaternion0[free])
-        world = np.vstack([m.vertex_local[start[b]:start[b + 1]] @ rot[k].T + model.position0[b] for k, b in enumerate(free)])
+        world = _world_vertices(m.vertex_local, start, model.position0, model.quaternion0, free)
         up = -m.gravity / g
         d = np.cross(model.rocking_axis, up)
         r_body = 0.5 * math.hypot(float(np.ptp(world @ d)), float(np.ptp(world @ up)))

@@ -591,14 +591,11 @@ def read_single_column(path: str | os.PathLike[str], *, dt: float, units: str | 
     return GroundMotion.from_samples(values, dt=dt, units=unit, name=p.stem, source=p)
 
 
-def _is_at2(p: Path, lines: list[str]) -> bool:
-    """A ``.AT2`` suffix or an NPTS/DT header line."""
-    head = lines[:_HEADER_SCAN_LINES]
-    return p.suffix.lower() == ".at2" or any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head)
-
-
 def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
-    if _is_at2(p, lines):
+    if p.suffix.lower() == ".at2":
+        return RecordFormat.AT2
+    head = lines[:_HEADER_SCAN_LINES]
+    if any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head):
         return RecordFormat.AT2
     for line in lines:
         text = line.split("#", 1)[0]
@@ -647,15 +644,12 @@ def read_record(path: str | os.PathLike[str], *, units: str | AccelerationUnit |
     p, lines = _read_lines(found)
     if format is not None and str(format).lower() not in {f.value for f in RecordFormat}:
         raise ValueError(f"{p}: unknown format {format!r}; use 'at2', 'columns' or 'single' (or omit it)")
-    if format is not None:
-        fmt = RecordFormat(str(format).lower())
-    elif chosen:  # columns chosen: a columns file of any width, unless it is an AT2 or one-column file
-        try:
-            fmt = _sniff_format(p, lines)
-        except ValueError:  # three columns or more
-            fmt = RecordFormat.COLUMNS
-    else:
-        fmt = _sniff_format(p, lines)
+    try:
+        fmt = RecordFormat(str(format).lower()) if format is not None else _sniff_format(p, lines)
+    except ValueError:  # three columns or more: with columns chosen, a columns file of any width
+        if not chosen:
+            raise
+        fmt = RecordFormat.COLUMNS
     if chosen and fmt is not RecordFormat.COLUMNS:
         raise ValueError(f"{p}: time_column and acc_column choose the columns of a time/acceleration file, "
                          f"and do not apply to the {fmt.value} format; leave them out")

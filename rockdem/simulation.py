@@ -387,9 +387,14 @@ class _Run:
     check_target: float | None = None  # the end of a stop-rule chunk the run that saved it did not reach
 
 
+def _frame_count(duration: float, record_interval: float) -> int:
+    """Frames a run to ``duration`` [s] records, one every ``record_interval`` [s] from t = 0."""
+    return int(math.floor(duration / record_interval + 1e-9)) + 1
+
+
 def _frames(model: Model, duration: float, record_interval: float) -> Records:
     """Zeroed records for every frame of a run to ``duration`` [s], refused above 2 GB."""
-    frames = int(math.floor(duration / record_interval + 1e-9)) + 1
+    frames = _frame_count(duration, record_interval)
     need = frames * model.block_count * 13 * 8
     if need > _MAX_RECORD_BYTES:
         raise ValueError(
@@ -453,8 +458,7 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
         if value is not None and value != saved:
             raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
                              f"the options it was started with; leave {name} unset")
-    frames = int(math.floor(duration / ck.record_interval + 1e-9)) + 1  # as _frames counts them
-    if frames <= ck.frame:
+    if _frame_count(duration, ck.record_interval) <= ck.frame:
         last = float(ck.records.time[ck.frame - 1]) if ck.frame else 0.0
         raise ValueError(f"nothing is left to compute: the checkpoint's run already recorded its frames up to t = {last:.6g} s "
                          f"(every {ck.record_interval:g} s), and a run to {duration:.6g} s records no later one; to run on, give "
