@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any, Iterator
 
 import numpy as np
 
+from ._warn import warn_user
 from .beta_choice import BetaChoice, RestitutionTarget
 from .kernels.contact import sp_critical_factor
 
@@ -382,7 +383,7 @@ def advise(inputs: AdviceInput | None = None, **kwargs: Any) -> Advice:
     rec_beta, why = _recommended(i, beta, choice)
     recs = _recommendations(i, rec_beta, alpha_mp, kn, eta_r, bouncing, dt_mp / dt_sp)
     for msg in warn:
-        warnings.warn(msg, stacklevel=2)
+        warn_user(msg)
     return Advice(
         inputs=i,
         rocking_height=h,

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from ._warn import warn_user
 
 __all__ = [
     "HalfCyclePeaks",
@@ -226,7 +227,7 @@ def apparent_restitution(peaks: ArrayLike, theta0: float, eta: float, *, exact: 
         raise ValueError(f"theta0 must lie in (0, eta = {eta:.6g}) rad, got {theta0!r} (a release beyond eta overturns)")
     p = np.abs(np.asarray(peaks, dtype=float)).ravel()
     if np.any(p > eta):
-        warnings.warn("apparent_restitution: some peaks exceed eta (overturning?); Eq. 6 is not defined there", stacklevel=2)
+        warn_user("apparent_restitution: some peaks exceed eta (overturning?); Eq. 6 is not defined there")
     n = np.arange(1, len(p) + 1)
 
     def energy(th: NDArray[np.float64] | float) -> NDArray[np.float64]:
@@ -295,11 +296,9 @@ def wme(
     if not np.any(inside):
         raise ValueError("wme: the simulation does not overlap the reference in time")
     if np.count_nonzero(inside) < np.count_nonzero(keep):
-        warnings.warn(
+        warn_user(
             f"wme: the simulation covers [{ts[0]:.4g}, {ts[-1]:.4g}] s only; reference samples up to "
-            f"{t_end:.4g} s outside it are ignored",
-            stacklevel=2,
-        )
+            f"{t_end:.4g} s outside it are ignored")
     x = xr[inside]
     y = np.interp(tr[inside], ts, xs)
     den = float(np.sum(x * x))

@@ -15,7 +15,6 @@ import math
 import os
 import threading
 import tomllib
-import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -23,6 +22,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from ._warn import warn_user
 from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
 from .geometry import MAX_FACE_POINTS
 from .materials import JointMaterial, check_material, ks_from_kn
@@ -214,7 +214,7 @@ def check_plausible(value: float, what: str, key: str = "") -> None:
         if value > refuse:
             raise ValueError(f"{what} = {value!r} is not plausible (above {refuse:g}; {why}); check the value and its units")
         if value > warn:
-            warnings.warn(f"{what} = {value!r} is above {warn:g}: {why}; check the value and its units", UserWarning, stacklevel=3)
+            warn_user(f"{what} = {value!r} is above {warn:g}: {why}; check the value and its units")
 
 
 @dataclass(frozen=True)

@@ -8,13 +8,13 @@ validates everything once and freezes it into a :class:`Model` of flat arrays
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._warn import warn_user
 from .beta_choice import BETA_MODES, BetaChoice, RestitutionTarget
 from .flatten import BlockFrame, flatten_geometry
 from .geometry import MAX_FACE_POINTS, Polyhedron, box, mass_properties
@@ -987,12 +987,11 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
             who, r_max = "the free blocks rocking as one body", r_body
     p = math.sqrt(0.75 * g / r_max) if g > 0.0 else 0.0
     if g > 0.0 and damping.alpha > 2.0 * p:
-        warnings.warn(
+        warn_user(
             f"damping.alpha = {damping.alpha:g} 1/s over-damps the rocking of {who}: "
             f"it is above 2 p = {2.0 * p:.3g} 1/s, critical for its rocking frequency p = sqrt(3 g / 4 R) = {p:.3g} rad/s "
             f"(R = {r_max:.3g} m), and velocities decay within 1/alpha = {1.0 / damping.alpha:.3g} s; the "
-            "paper's MP values are 0.05 to 1 1/s (alpha = 22.4 beta + 0.05)", UserWarning, stacklevel=3,
-        )
+            "paper's MP values are 0.05 to 1 1/s (alpha = 22.4 beta + 0.05)")
     beta = damping.beta
     if isinstance(beta, str) or not beta > 0.0:
         return
@@ -1002,13 +1001,11 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
     k = int(np.argmin(omega))
     critical = 2.0 / float(omega[k])
     if beta > OVERDAMPED_BETA * critical:
-        warnings.warn(
+        warn_user(
             f"damping.beta = {beta:g} s is {beta / critical:.3g} times the critical value 2 / omega = {critical:.3g} s "
             f"of the slowest impact (block {model.block_names[int(free[k])]!r} on its smallest face, omega = "
             f"{float(omega[k]):.4g} rad/s): every impact is over-damped, blocks settle into their joints over about "
-            f"beta seconds; DeJong's beta (paper §2.2) is the critical one (damping.beta = \"critical\")",
-            UserWarning, stacklevel=3,
-        )
+            f"beta seconds; DeJong's beta (paper §2.2) is the critical one (damping.beta = \"critical\")")
 
 
 def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointMaterial], size: float) -> None:
@@ -1021,32 +1018,27 @@ def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointM
     """
     for blk in blocks:
         if blk.driven is False and blk.density < PLAUSIBLE_DENSITY:
-            warnings.warn(
+            warn_user(
                 f"block {blk.name!r}: density {blk.density:g} kg/m^3 is lighter than any masonry "
-                f"(1500-2500 kg/m^3); if it is in t/m3, give it x 1000 (SI units: kg/m^3)", UserWarning, stacklevel=3,
-            )
+                f"(1500-2500 kg/m^3); if it is in t/m3, give it x 1000 (SI units: kg/m^3)")
             break
         if blk.driven is False and blk.density > HEAVIEST_DENSITY:
-            warnings.warn(
+            warn_user(
                 f"block {blk.name!r}: density {blk.density:g} kg/m^3 is heavier than any building material "
-                f"(masonry 1500-2500 kg/m^3, steel 7850); check its units (SI: kg/m^3)", UserWarning, stacklevel=3,
-            )
+                f"(masonry 1500-2500 kg/m^3, steel 7850); check its units (SI: kg/m^3)")
             break
     for (ga, gb), mat in mats.items():
         for label, angle in (("friction_angle", mat.friction_angle), ("residual_friction_angle", mat.residual_friction_angle)):
             if angle is not None and 0.0 < angle < PLAUSIBLE_FRICTION_ANGLE:
-                warnings.warn(
+                warn_user(
                     f"joint {ga!r}-{gb!r}: {label} = {angle:g} deg is almost frictionless; if {angle:g} is a friction "
-                    f"coefficient mu, give the angle atan(mu) = {math.degrees(math.atan(angle)):.3g} deg",
-                    UserWarning, stacklevel=3,
-                )
+                    f"coefficient mu, give the angle atan(mu) = {math.degrees(math.atan(angle)):.3g} deg")
                 break
     for (ga, gb), mat in mats.items():
         modulus = mat.kn * size
         if modulus < PLAUSIBLE_MODULUS:
-            warnings.warn(
+            warn_user(
                 f"joint {ga!r}-{gb!r}: kn = {mat.kn:g} N/m^3 implies a youngs_modulus of about kn x {size:g} m = "
-                f"{modulus:g} Pa, below 1 MPa; moduli are in Pa (1.8 GPa is 1.8e9), not MPa", UserWarning, stacklevel=3,
-            )
+                f"{modulus:g} Pa, below 1 MPa; moduli are in Pa (1.8 GPa is 1.8e9), not MPa")
             break
 

@@ -25,7 +25,6 @@ import hashlib
 import math
 import os
 import re
-import warnings
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from importlib import resources
@@ -33,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from ._warn import warn_user
 
 __all__ = [
     "STANDARD_GRAVITY",
@@ -475,9 +475,9 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
         raise ValueError(f"{p}: dt must be positive, got {step!r} (pass dt=... to override the header)")
     allowed = min(rounding, DT_OVERRIDE_SHARE * dt_head)
     if dt is not None and abs(dt - dt_head) > allowed * (1.0 + 1e-9):
-        warnings.warn(f"{p}: dt = {dt:g} s overrides the header's DT = {dt_head:g} s (line {i_head + 1}) by more "
+        warn_user(f"{p}: dt = {dt:g} s overrides the header's DT = {dt_head:g} s (line {i_head + 1}) by more "
                       f"than its rounding ({allowed:g} s): the record's {npts * dt_head:g} s become "
-                      f"{npts * dt:g} s; omit dt to use the header's", UserWarning, stacklevel=2)
+                      f"{npts * dt:g} s; omit dt to use the header's")
     # NGA files put the event and station on line 2 under a fixed banner; other variants on line 1.
     banner = lines[0].strip().upper().startswith("PEER")
     description = lines[1].strip() if banner and i_head >= 2 else lines[0].strip() if i_head >= 1 else ""
@@ -551,9 +551,9 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
                          f"{dt_typ!r} s; rockdem needs a uniform dt (resample the file first)")
     dt = (t[-1] - t[0]) / (t.size - 1)
     if dt == 1.0 and t[0] in (0.0, 1.0) and np.all(t == np.round(t)):
-        warnings.warn(f"{p}: column {time_column} counts the samples ({t[0]:g}, {t[1]:g}, {t[2] if t.size > 2 else t[1]:g}, ...) "
+        warn_user(f"{p}: column {time_column} counts the samples ({t[0]:g}, {t[1]:g}, {t[2] if t.size > 2 else t[1]:g}, ...) "
                       "rather than giving times: dt = 1 s; if it is an index, give time_column (zero-based) for the "
-                      "column of times", UserWarning, stacklevel=2)
+                      "column of times")
     return GroundMotion.from_samples(acc, dt=dt, units=unit, name=p.stem, source=p,
                                      description=" | ".join(c for c in comments if c), start_time=float(t[0]))
 

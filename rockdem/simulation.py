@@ -32,7 +32,6 @@ import os
 import signal
 import threading
 import time as _time
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping, NamedTuple, Sequence
@@ -41,6 +40,7 @@ import numba
 import numpy as np
 import xarray as xr
 
+from ._warn import warn_user
 from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance, advance_parallel
@@ -342,7 +342,7 @@ def run_model(
             attrs.update({"stop_reason": decision.reason, "stop_time": decision.time, "stop_block": decision.block})
         if status in (STATUS_DIVERGED, STATUS_LOST):
             attrs.update(_failure(model, rec, frame - 1, status, int(scratch.lost_block[0]), int(state.step[0])))
-            warnings.warn(attrs["diverged_message"], RuntimeWarning, stacklevel=2)
+            warn_user(attrs["diverged_message"], RuntimeWarning)
             frame -= 1  # keep the sound frames before the bad one
         elif sunk is not None:
             t_now = float(state.time[0])
@@ -351,7 +351,7 @@ def run_model(
             msg = f"the run stopped at {when} (step {int(state.step[0])}): {what}; the result holds the frames computed"
             attrs.update({"diverged": 1, "diverged_time": t_now, "diverged_step": int(state.step[0]),
                           "diverged_blocks": block, "diverged_reason": "sank", "diverged_message": msg})
-            warnings.warn(msg, RuntimeWarning, stacklevel=2)
+            warn_user(msg, RuntimeWarning)
         elif checkpoint is not None:  # every frame computed, also past a stop decision (see the module notes)
             attrs["checkpoint"] = str(saver.save(state, scratch, rec, frame, snaps, runtime, target))
         if attrs.get("diverged") and checkpoint is not None:
@@ -361,11 +361,10 @@ def run_model(
             listed = ", ".join(f"{model.block_names[b]} ({state.fell_off[b]:.3g} s)" for b in fell)
             attrs["fell_off_blocks"] = ", ".join(model.block_names[b] for b in fell)
             attrs["fell_off_times"] = state.fell_off[fell].astype(float)
-            warnings.warn(
+            warn_user(
                 f"block(s) fell off the edge of the model's supports and fall on unhindered: {listed}; "
                 "a larger foundation (the specimen builders' foundation_extent) keeps them",
-                RuntimeWarning, stacklevel=2,
-            )
+                RuntimeWarning)
         end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
         return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
 

@@ -54,6 +54,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import brentq
 
+from ._warn import warn_user
 from .analysis import SUMMARY_PEAK_PROMINENCE, apparent_restitution, half_cycle_peaks
 from .beta_choice import BETA_CRITICAL, BetaChoice, PairBeta, RestitutionTarget
 from .housner import HousnerBlock, quarter_period
@@ -430,12 +431,10 @@ def _search(probe: Probe, target: float, beta0: float, fixed: dict[tuple[str, st
     best = min(evals, key=lambda r: abs(r.e_a - target))
     if abs(best.e_a - target) > CLOSE * target:
         near = sorted(evals, key=lambda r: r.beta)
-        warnings.warn(
+        warn_user(
             f"damping.target_restitution = {label}: the closest apparent restitution reached is {best.e_a:.4f} (target "
             f"{target:.4f}) at beta = {best.beta:.4g} s; e_a jumps across the target between probe runs ("
-            + ", ".join(f"{r.beta:.4g} s: {r.e_a:.4f}" for r in near) + ")",
-            UserWarning, stacklevel=4,
-        )
+            + ", ".join(f"{r.beta:.4g} s: {r.e_a:.4f}" for r in near) + ")")
     return best.beta, best.e_a, evals
 
 
