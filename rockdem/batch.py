@@ -19,6 +19,7 @@ arrays), so a spec's row is identical, bit for bit (timings aside), whichever pa
 from __future__ import annotations
 
 import json
+import signal
 import threading
 import time
 import warnings
@@ -116,7 +117,18 @@ def _specimen_eta(data: Mapping[str, Any]) -> float | None:
 
 def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]:
     """The summary row of a run of ``spec`` (a :class:`rockdem.studies.RunSpec`) with case dict
-    ``data`` (keys: see :func:`rockdem.studies.run_spec`); ``wall_s`` is added by the caller."""
+    ``data`` (keys: see :func:`rockdem.studies.run_spec`); ``wall_s`` is added by the caller.
+
+    Raises:
+        rockdem.cli.Interrupted: the run was interrupted, or a stop signal arrived as it finished
+            (a KeyboardInterrupt: the study stops and stores no row of this run)."""
+    a = f.attrs
+    if a.get("interrupted") or a.get("stop_signal"):
+        # Cut short by a stop signal (or with one pending): no row, so that a resumed study runs it
+        # again, and the study stops as the signal asked.
+        from .cli import Interrupted
+
+        raise Interrupted(int(a.get("stop_signal") or signal.SIGINT))
     free = np.flatnonzero(f.block_free)
     b = int(free[0])
     t = f.time
@@ -128,7 +140,6 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         s = summarize(t, theta, eta=eta_used, z=z)
-    a = f.attrs
     npts = max(int(a.get("point_count", 1)), 1)
     row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "diverged" if a.get("diverged") else "ok"}
     if a.get("diverged"):

@@ -193,7 +193,11 @@ def main(argv: list[str] | None = None) -> int:
     reference cycles are then not finalized at exit, which Python does not promise anyway; the
     commands close their files themselves.
     """
-    status = _main(argv)
+    try:
+        status = _main(argv)
+    except KeyboardInterrupt as exc:  # a Ctrl-C while the command's modules load, before it runs
+        print(f"rockdem: stopped by {signal.Signals(exit_status(exc) - 128).name} while starting", file=sys.stderr)
+        return exit_status(exc)
     if argv is None:
         gc.freeze()
     return status

@@ -6,8 +6,9 @@ asks for it. A run that goes wrong stops at the first bad recorded frame: when i
 breaks or its state is no longer finite (diverged), or when a free block leaves the model's extent
 (it fell through its support or flew away); the result keeps the frames before it and says where
 (``attrs["diverged"]``, ``diverged_time``, ``diverged_step``, ``diverged_blocks``,
-``diverged_reason``). An interrupted run (Ctrl-C) returns the frames computed so far, flagged
-``interrupted``. A run can be saved to a checkpoint and continued exactly (:mod:`rockdem.checkpoint`).
+``diverged_reason``). An interrupted run (Ctrl-C, or SIGTERM / SIGHUP under ``rockdem``) returns the
+frames computed so far, flagged ``interrupted``; ``stop_signal`` names the signal (also when it arrived
+only as the finished result was put together). A run can be saved to a checkpoint and continued exactly (:mod:`rockdem.checkpoint`).
 With ``stop=`` (:mod:`rockdem.stopping`) the loop checks between chunks of a fixed number of steps
 whether the outcome is decided (collapsed, or at rest after the input) and ends there
 (``attrs["stop_reason"]``, ``stop_time``). :func:`run_model` is the loop without the Dataset
@@ -152,8 +153,11 @@ def simulate(
                     dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
                     contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
                     checkpoint=checkpoint, checkpoint_every=checkpoint_every, threads=threads)
-    with _deferred_signals(finishing=True):
+    late: list[int] = []
+    with _deferred_signals(finishing=True, late=late):
         ds = out.snapshots.attach(build_dataset(model, out.records, monitors=out.monitors, attrs=out.attrs))
+    if late and not ds.attrs.get("stop_signal"):
+        ds.attrs["stop_signal"] = late[0]
     return ds
 
 
@@ -267,6 +271,7 @@ def run_model(
     kernel = 0.0
     bar = None
     interrupted = False
+    stop_signal = 0  # the stop signal that cut the loop short, or that arrived as the result was put together
     try:
         t_end = duration + 0.5 * info.dt  # one step past the end records the frame at t = duration
         while decision is None and state.time[0] < t_end and frame < frames:
@@ -303,14 +308,16 @@ def run_model(
                 bar = _progress_bar(duration, run.start_time)
             if bar is not None:
                 bar.update(min(float(state.time[0]), duration) - bar.n)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         interrupted = True
+        stop_signal = int(getattr(exc, "signum", signal.SIGINT))
     finally:
         if bar is not None:
             bar.close()
     # Past the loop the frames are computed (all of them, or those before a stop): a stop signal from
     # here on is held until the result is put together, and the result is returned (_deferred_signals).
-    with _deferred_signals(finishing=True):
+    late: list[int] = []
+    with _deferred_signals(finishing=True, late=late):
         if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
             decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
         runtime = _time.perf_counter() - wall0 + run.runtime_before
@@ -366,7 +373,10 @@ def run_model(
                 "a larger foundation (the specimen builders' foundation_extent) keeps them",
                 RuntimeWarning)
         end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
-        return RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
+        out = RunOutput(Records(*(a[:end] for a in rec)), attrs, mon, snaps)
+    if stop_signal or late:
+        attrs["stop_signal"] = stop_signal or late[0]
+    return out
 
 
 @dataclass
@@ -508,13 +518,15 @@ class _Saver:
 
 
 @contextlib.contextmanager
-def _deferred_signals(finishing: bool = False) -> Iterator[None]:
+def _deferred_signals(finishing: bool = False, late: list[int] | None = None) -> Iterator[None]:
     """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
     deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
     halfway through it. With ``finishing`` (the result of a run being put together once its loop
     has ended: every frame computed, or those before a stop), the KeyboardInterrupt the handler
     raises is caught, so that the result is returned; the handler has seen the signal (``rockdem
-    run`` then notes it and exits once the result is saved). Outside the main thread (where no signal arrives) this does nothing."""
+    run`` then notes it and exits once the result is saved), and its number is appended to ``late``
+    (a study then stores no row of the run and stops). Outside the main thread (where no signal
+    arrives) this does nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -537,6 +549,8 @@ def _deferred_signals(finishing: bool = False) -> Iterator[None]:
             except KeyboardInterrupt:
                 if not finishing:
                     raise
+                if late is not None:
+                    late.append(int(signum))
 
 
 SINK_FRACTION = 0.25

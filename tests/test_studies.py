@@ -97,6 +97,40 @@ def test_sweep_200_runs_local_pool_and_dask_identical(base, tmp_path):
     print(f"200 runs on the local pool (2 workers): {t_pool:.1f} s")
 
 
+def test_ctrl_c_in_a_serial_sweep_stores_no_cut_short_run(base, tmp_path):
+    """A Ctrl-C during a run of a serial study stops the study; the run it cut short is not stored
+    (simulate returns its partial frames, flagged interrupted, which a row must not summarise)."""
+    specs = make_specs(base, expand_grid({"damping.alpha": [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]}), fixed=MP, duration=30.0)
+    spec_file = tmp_path / "specs.pkl"
+    spec_file.write_bytes(pickle.dumps(specs))
+    store = Store(tmp_path / "study")
+    script = textwrap.dedent(f"""
+        import pickle
+        from rockdem.studies import execute
+        execute(pickle.load(open({str(spec_file)!r}, "rb")), {str(tmp_path / "study")!r}, executor="serial", progress=False)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE)
+    try:
+        deadline = time.time() + 300
+        while time.time() < deadline and len(store.done_ids()) < 2 and proc.poll() is None:
+            time.sleep(0.02)
+        t_row = time.time()
+        while time.time() < deadline and len(store.done_ids()) < 3 and proc.poll() is None:
+            time.sleep(0.02)
+        per_run = time.time() - t_row
+        time.sleep(0.4 * per_run)  # well inside the fourth run
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode != 0 and (b"KeyboardInterrupt" in err or b"Interrupted: SIGINT" in err)  # stopped, as Ctrl-C asks
+    rows = store.rows()
+    assert 3 <= len(rows) < len(specs)
+    by_id = {s.id: s for s in specs}
+    for r in rows:  # every stored run went to its end: the steps of the same run, uninterrupted
+        assert r["steps"] == run_spec(by_id[r["id"]])["steps"]
+
+
 def test_interrupted_sweep_resumes_without_recomputing(base, tmp_path):
     specs = _sweep_specs(base, n_alpha=6, n_tilt=5)
     spec_file = tmp_path / "specs.pkl"
