@@ -508,7 +508,7 @@ def summarize(
     # half cycles of rocking reach back to ~0, so their prominence is their height; 2 % of the largest
     # rotation keeps every real half cycle but not the vibration of a brick riding on a rocking wall
     pk = half_cycle_peaks(t, th, min_prominence=SUMMARY_PEAK_PROMINENCE * max_rotation(th))
-    out["half_cycles"] = int(len(pk.value))
+    out["half_cycles"] = int(len(pk.value)) if out["onset_time_s"] is not None else 0  # vibration below the onset is not rocking
     if eta is not None:
         out["eta_rad"] = float(eta)
         out["exceeded_eta"] = bool(max_rotation(th) > eta)

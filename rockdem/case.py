@@ -598,7 +598,7 @@ class CaseTemplate:
         ctx = _loading(top, builder, monitors, run)
         output = _output(top)
         top.finish()
-        model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis", (0.0, 1.0, 0.0)),
+        model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis"),
                                  contact_tolerance=run.contact_tolerance)
         self._ctx = ctx
         self._builder = builder  # what an automatic beta is resolved on
@@ -634,7 +634,7 @@ class CaseTemplate:
             builder, monitors = copy.copy(self._bare), dict(self._monitors)
             ctx = _loading(top, builder, monitors, run)
             model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
-            axis = np.asarray(ctx.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)  # the load's own direction
+            axis = np.asarray(ctx.get("rocking_axis", builder.default_rocking_axis()), dtype=float)  # the load's own direction
             model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
         else:
             top.used.add("loading")

@@ -546,6 +546,17 @@ class ModelBuilder:
         self._release = Release(tuple(b.name for b in blocks), float(fraction), self._horizontal(d))
         return geo.angle
 
+    def default_rocking_axis(self) -> NDArray[np.float64]:
+        """(3,) the rocking axis :meth:`finalize` takes by default: the line the last :meth:`tilt`
+        turned the blocks about, oriented along +y where it has a y component, else along -x (so
+        that a positive ``rocking_angle`` tips towards +x, or towards +y for rocking in y-z,
+        whichever way the tilt went); y without a tilt."""
+        if self._release is None:
+            return np.array([0.0, 1.0, 0.0])
+        turn = np.cross(self._up(), self._release.direction)
+        ref = np.array([0.0, 1.0, 0.0]) if abs(turn[1]) > 1e-9 else np.array([-1.0, 0.0, 0.0])
+        return (turn if turn @ ref >= 0.0 else -turn) + 0.0
+
     def _up(self) -> NDArray[np.float64]:
         gn = np.linalg.norm(self.gravity)
         return -self.gravity / gn if gn > 0 else np.array([0.0, 0.0, 1.0])
@@ -686,7 +697,7 @@ class ModelBuilder:
         *,
         damping: Damping = Damping(),
         contact_tolerance: float | None = None,
-        rocking_axis: ArrayLike = (0.0, 1.0, 0.0),
+        rocking_axis: ArrayLike | None = None,
     ) -> Model:
         """Validate and freeze the model.
 
@@ -697,7 +708,10 @@ class ModelBuilder:
                 the largest elastic opening or slip of a bonded joint at its strength (ft / kn,
                 c / ks), so that a bond is never lost to the tolerance before it breaks. The
                 point-in-face test uses it plus the point's own penetration.
-            rocking_axis: world axis of the recorded ``rocking_angle`` (default y: rocking in x-z).
+            rocking_axis: world axis of the recorded ``rocking_angle``; default the line the
+                :meth:`tilt` turned the blocks about, oriented along +y where it has a y component
+                (y for a tilt along +x or -x: a positive angle tips towards +x), else along -x (a
+                tilt along +y or -y: a positive angle tips towards +y); without a tilt, y.
         """
         if not self._blocks:
             raise ValueError("the model has no blocks; add blocks before finalize()")
@@ -782,7 +796,9 @@ class ModelBuilder:
             contact_tolerance = max(0.01 * min_dim, 1.5 * opening)
         if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
             raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
-        axis = np.asarray(rocking_axis, dtype=float).reshape(3)
+        if rocking_axis is None:
+            rocking_axis = self.default_rocking_axis()
+        axis = np.asarray(rocking_axis, dtype=float).reshape(3) + 0.0  # + 0.0: no -0.0
         if not np.linalg.norm(axis) > 0:
             raise ValueError("rocking_axis must be a non-zero 3-vector")
         arrays = ModelArrays(

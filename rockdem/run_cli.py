@@ -149,6 +149,12 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
         if len(free) > 1 and all(v in ds for v in ("block_position", "vertex_local", "block_vertex_start")):
             lines.append(_blocks_row("fallen blocks", ds, fallen_blocks(ds), len(free),
                                      f"centroid dropped by over {FALL_FRACTION:g} of its smallest dimension"))
+        if a.get("fell_off_blocks"):
+            names = [s.strip() for s in str(a["fell_off_blocks"]).split(",")]
+            times = np.atleast_1d(np.asarray(a.get("fell_off_times", np.full(len(names), np.nan)), dtype=float))
+            listed = ", ".join(f"{n} at {t:.3g} s" for n, t in zip(names[:3], times[:3])) + (", ..." if len(names) > 3 else "")
+            lines.append(_row("fell off the supports", f"{len(names)}", "",
+                              f"of {len(free)}: falling on unhindered ({listed}); a larger foundation keeps them"))
         if len(free) > 1 and "block_eta" in ds:
             with np.errstate(invalid="ignore"):
                 tipped = free[np.abs(ds.rocking_angle.values[-1, free]) > ds.block_eta.values[free]]

@@ -138,3 +138,22 @@ def test_toppling_block_lands_and_comes_to_rest():
     assert float(ds.block_position[-1, 1, 2]) == pytest.approx(b / 2, abs=0.01)
     assert float(ds.energy_kinetic[-1]) < 1e-3 * float(-ds.energy_potential.min())
     assert ds.attrs["dt_min"] < ds.attrs["dt"]  # the stiffer side-face contact lowered the step
+
+
+@pytest.mark.parametrize("direction,axis", [((1, 0, 0), (0, 1, 0)), ((-1, 0, 0), (0, 1, 0)),
+                                            ((0, 1, 0), (-1, 0, 0)), ((0, -1, 0), (-1, 0, 0))])
+def test_rocking_angle_is_measured_about_the_tilt_s_own_line(direction, axis):
+    # A block 0.3 x 0.2 x 1.2 m tilted to half its instability angle about the base edge on the
+    # side of ``direction`` (eta = atan(b / h) of the side it tips over: b = 0.3 along x, 0.2 along
+    # y). The rocking angle is measured about that line, positive towards +x (or +y).
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e9, friction_angle=80)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.3, 0.2, 1.2, density=2000, name="block")
+    angle = b.tilt("block", 0.5, direction=direction)
+    model = b.finalize(damping=Damping(beta=1e-4))
+    np.testing.assert_allclose(model.rocking_axis, axis, atol=1e-12)
+    eta = math.atan((0.3 if direction[0] else 0.2) / 1.2)
+    assert angle == pytest.approx(0.5 * eta, rel=1e-9)
+    ds = simulate(model, 0.01, record_interval=0.005)
+    assert float(ds.rocking_angle.values[0, 1]) == pytest.approx(sum(direction) * 0.5 * eta, rel=1e-9)
