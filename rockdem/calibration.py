@@ -16,8 +16,10 @@ results are robust shows up there as a much larger sensitivity for ``damping.alp
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
+import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -31,7 +33,7 @@ from .analysis import wme
 from .plots import save_figure
 from .batch import batch_row
 from .case import parse_assignment
-from .studies import RunSpec, check_first_run, execute, resolve_base, with_stop
+from .studies import RunSpec, Store, check_first_run, execute, resolve_base, with_stop
 
 __all__ = ["Reference", "load_reference", "reference_from_row", "CalibrationResult", "calibrate", "wme_of_row", "register_cli"]
 
@@ -74,10 +76,16 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         else:
             x = np.asarray(ds.monitor_displacement.values[:, 0, 0], dtype=float)
         return Reference(t, x, quantity)
-    df = pd.read_csv(p, sep=None, engine="python", header=None, comment="#")
+    need = f"need rows of time [s] and value (column {column}, zero-based), separated by commas, spaces or tabs"
+    try:
+        df = pd.read_csv(p, sep=None, engine="python", header=None, comment="#")
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, csv.Error) as exc:
+        raise ValueError(f"reference {p}: cannot be read as a table ({exc}); {need}") from None
     df = df.apply(pd.to_numeric, errors="coerce").dropna()
     if df.shape[1] <= column:
-        raise ValueError(f"{p}: need a time column and a value column {column}, found {df.shape[1]} columns")
+        raise ValueError(f"reference {p}: {need}; found {df.shape[1]} column(s)")
+    if len(df) < 2:
+        raise ValueError(f"reference {p}: {len(df)} numeric row(s); {need}, at least two rows")
     return Reference(df.iloc[:, 0].to_numpy(float), df.iloc[:, column].to_numpy(float), quantity)
 
 
@@ -326,14 +334,29 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
 
 
 def _calibrate_cli(args: argparse.Namespace) -> int:
+    from .cli import stop_on_signals
+
     ref = load_reference(args.reference, quantity=args.quantity)
     fixed = dict(parse_assignment(item) for item in args.set or [])
-    res = calibrate(args.base, args.parameter, args.bounds, ref, fixed=fixed, duration=args.duration,
-                    log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
-                    workers=args.workers, scheduler=args.scheduler, stop=args.stop)
+    if not args.linear and min(args.bounds) <= 0:
+        raise ValueError(f"--bounds {args.bounds[0]:g} {args.bounds[1]:g}: the search is in log(parameter) and needs "
+                         "positive bounds; add --linear for a parameter that may be 0")
+    out = Path(args.out) if args.out else None
+    if out is not None and out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is an existing file; give a folder")
+    store = Store(out) if out is not None else None  # finished runs kept: a rerun resumes
+    try:
+        with stop_on_signals():  # SIGTERM and SIGHUP stop it as Ctrl-C does
+            res = calibrate(args.base, args.parameter, args.bounds, ref, fixed=fixed, duration=args.duration,
+                            log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
+                            workers=args.workers, scheduler=args.scheduler, stop=args.stop, store=store)
+    except KeyboardInterrupt:
+        kept = ("give --out to keep finished runs" if store is None else f"the finished runs are kept in {store.path} (rerun to "
+                "resume)" if store.path.exists() else "no run had finished (nothing kept)")
+        print(f"rockdem calibrate: stopped; {kept}", file=sys.stderr)
+        raise
     print(res.report())
-    if args.out:
-        out = Path(args.out)
+    if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         res.evaluations.to_csv(out / "evaluations.csv", index=False)
         if res.curve is not None:
@@ -358,6 +381,6 @@ def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable
     p.add_argument("--scan", type=int, default=9, help="coarse scan points before the bounded search")
     p.add_argument("--stop", choices=("rest", "off"), default="rest",
                    help="end each run once it is at rest after its input (default; its history is continued at rest) or run it to the end")
-    p.add_argument("--out", "-o", default=None, help="folder for report.txt, curve.csv, wme.png")
+    p.add_argument("--out", "-o", default=None, help="folder for report.txt, curve.csv, wme.png and runs.jsonl (a rerun resumes)")
     add_exec_args(p)
     p.set_defaults(func=_calibrate_cli)

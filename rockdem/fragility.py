@@ -31,6 +31,7 @@ import pandas as pd
 from scipy.optimize import minimize
 from scipy.stats import norm
 
+from ._warn import warn_user
 from .case import parse_assignment, parse_case
 from .intensity import IM_COLUMNS, response_spectrum, rocking_period, spec_intensities
 from .loading import earthquake_record
@@ -70,6 +71,8 @@ class Fragility:
     theta: float
     beta: float
     n: int = 0
+    separated: bool = False
+    """The outcomes were completely separated by the intensity (:func:`separated`): beta is not identifiable."""
 
     def probability(self, im: Any) -> np.ndarray:
         """P(failure | IM)."""
@@ -204,19 +207,31 @@ def add_intensities(table: pd.DataFrame, specs: Sequence[RunSpec], period: float
 def fit_all(table: pd.DataFrame) -> pd.DataFrame:
     """Binomial MLE fragility against every IM column present (:data:`rockdem.intensity.IM_COLUMNS`)
     over the completed runs: columns ``im``, ``label``, ``theta``, ``beta``, ``n`` (NaN where the
-    runs do not have both failures and survivals)."""
+    runs do not have both failures and survivals) and ``separated`` (:func:`separated`: beta is
+    then not identifiable)."""
     done = table[completed(table)]
     rows = []
     for im, label in IM_COLUMNS.items():
         if im not in done or done[im].isna().all():
             continue
         sub = done[done[im].notna() & (done[im] > 0)]
+        sep = separated(sub[im].astype(float), sub["failed"].astype(bool))
         try:
             f = fit_fragility_mle(sub[im].astype(float), sub["failed"].astype(int))
-            rows.append({"im": im, "label": label, "theta": f.theta, "beta": f.beta, "n": f.n})
+            rows.append({"im": im, "label": label, "theta": f.theta, "beta": f.beta, "n": f.n, "separated": sep})
         except ValueError:
-            rows.append({"im": im, "label": label, "theta": np.nan, "beta": np.nan, "n": len(sub)})
-    return pd.DataFrame(rows, columns=["im", "label", "theta", "beta", "n"])
+            rows.append({"im": im, "label": label, "theta": np.nan, "beta": np.nan, "n": len(sub), "separated": sep})
+    return pd.DataFrame(rows, columns=["im", "label", "theta", "beta", "n", "separated"])
+
+
+def separated(im: Sequence[float], failed_: Sequence[bool]) -> bool:
+    """Whether the outcomes are completely separated by the intensity: every failure above every
+    survival. The likelihood then grows as the dispersion goes to 0, so the fitted beta only
+    says how far apart the levels were, not the record-to-record dispersion: more records, or
+    levels between the last survival and the first failure, are needed."""
+    x = np.asarray(im, dtype=float)
+    z = np.asarray(failed_, dtype=bool)
+    return bool(z.any() and (~z).any() and x[~z].max() < x[z].min())
 
 
 def characteristic_period(specs: Sequence[RunSpec]) -> float | None:
@@ -244,6 +259,37 @@ def _check_cases(specs: Sequence[RunSpec], per_record: int) -> None:
         n = len(specs) // per_record
         raise ValueError(f"no run of the IDA can start ({'its record' if n == 1 else f'none of its {n} records'} gives a "
                          f"valid case; nothing was run): {first}")
+
+
+STRONG_MOTION_SHARE = 0.95
+"""A run that ends before this share of its record's Arias intensity has arrived is cut short."""
+
+
+def _cut_short(specs: Sequence[RunSpec]) -> list[str]:
+    """Notes on the records whose runs end (``run.duration``) before their strong motion has
+    arrived (:data:`STRONG_MOTION_SHARE` of the Arias intensity) or before their PGA: the
+    table's intensity measures are the whole record's, which the block did not feel."""
+    notes = []
+    for spec in specs:
+        data = spec.case_dict()
+        load, end = data.get("loading", {}), data.get("run", {}).get("duration")
+        if load.get("type") != "earthquake" or end is None:
+            continue
+        try:
+            gm = earthquake_record(load, scale=1.0)
+        except (ValueError, FileNotFoundError, OSError):
+            continue  # its runs error, reported apart
+        a2 = np.cumsum(np.asarray(gm.acceleration, dtype=float) ** 2)
+        t = float(load.get("delay", 0.0)) + gm.start_time + gm.dt * np.arange(a2.size)
+        t_strong = float(t[np.searchsorted(a2, STRONG_MOTION_SHARE * a2[-1])])
+        t_peak = float(t[int(np.argmax(np.abs(gm.acceleration)))])
+        missed = [what for what, at in ((f"{STRONG_MOTION_SHARE:.0%} of its Arias intensity has arrived ({t_strong:.3g} s)", t_strong),
+                                        (f"its PGA ({t_peak:.3g} s)", t_peak)) if float(end) < at]
+        if missed:
+            notes.append(f"record {load.get('record')!r}: the runs end at t = {float(end):g} s (run.duration), before "
+                         f"{' and '.join(missed)}; the table's intensity measures are the whole record's, not what the "
+                         "block felt: lengthen the runs (--duration) or leave the duration to the record")
+    return notes
 
 
 def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], out: str | os.PathLike[str], *,
@@ -280,6 +326,9 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
         raise ValueError(f"give a list of at least one record and one PGA level [g], got records={records!r}, pga_g={pga_g!r}")
     specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration, stop=stop)
     _check_cases(specs, len(pga_g))
+    notes = _cut_short(specs[::len(pga_g)])
+    for note in notes:
+        warn_user(note)
     store = Store(out)
     execute(specs, store, executor=executor, workers=workers, scheduler=scheduler, progress=progress, batch=batch)
     df = study_table(store, specs=specs)
@@ -297,11 +346,12 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
     fits = fit_all(df)
     fits.to_csv(Path(out) / "fragility.csv", index=False)
     chosen = fits[fits["im"] == im].iloc[0]
-    frag = None if not np.isfinite(chosen["theta"]) else Fragility(float(chosen["theta"]), float(chosen["beta"]), int(chosen["n"]))
+    frag = None if not np.isfinite(chosen["theta"]) else Fragility(float(chosen["theta"]), float(chosen["beta"]), int(chosen["n"]),
+                                                                    bool(chosen["separated"]))
     plot_ida(df, Path(out) / "ida.png", drift_limit=drift_limit, im=im)
     plot_fragility_all(df, fits, Path(out) / "fragility.png")
     plot_spectra(specs, Path(out) / "spectra.png", period=t_p)
-    write_report(df, fits, Path(out), drift_limit=drift_limit, period=t_p)
+    write_report(df, fits, Path(out), drift_limit=drift_limit, period=t_p, notes=notes)
     return df, frag
 
 
@@ -429,7 +479,8 @@ def _fragility_axes(ax: Any, frag: Fragility | None, table: pd.DataFrame | None,
         ax.scatter(x, f, s=12 + 40 * n / max(n.max(), 1), color="C1", zorder=3, label="observed fraction (binned)")
     if frag is not None:
         xs = np.linspace(hi * 1e-3, hi, 300)
-        ax.plot(xs, frag.probability(xs), color="C0", label=f"theta = {frag.theta:.3g}, beta = {frag.beta:.3g}")
+        ax.plot(xs, frag.probability(xs), color="C0", label=f"theta = {frag.theta:.3g}, beta = {frag.beta:.3g}"
+                + (" (separated: beta not identifiable)" if frag.separated else ""))
     else:
         ax.text(0.5, 0.5, "not fitted\n(no failures or no survivals)", transform=ax.transAxes, ha="center", fontsize=8)
     ax.set_xlabel(_im_label(table, im))
@@ -448,7 +499,7 @@ def plot_fragility_all(table: pd.DataFrame, fits: pd.DataFrame, path: str | os.P
     rows = (n + cols - 1) // cols
     fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 3.6 * rows), squeeze=False)
     for ax, (_, r) in zip(axes.flat, fits.iterrows()):
-        frag = Fragility(float(r["theta"]), float(r["beta"]), int(r["n"])) if np.isfinite(r["theta"]) else None
+        frag = Fragility(float(r["theta"]), float(r["beta"]), int(r["n"]), bool(r.get("separated", False))) if np.isfinite(r["theta"]) else None
         _fragility_axes(ax, frag, table, str(r["im"]))
     for ax in list(axes.flat)[len(fits):]:
         ax.set_visible(False)
@@ -493,9 +544,14 @@ def plot_spectra(specs: Sequence[RunSpec], path: str | os.PathLike[str], *, peri
     return p
 
 
+SEPARATED_NOTE = ("Separated: every run that failed had a higher intensity than every run that survived, so the "
+                  "likelihood grows as the dispersion goes to 0 and the fitted beta says only how far apart the "
+                  "levels were. Add records, or levels between the last survival and the first failure.")
+
+
 def write_report(table: pd.DataFrame, fits: pd.DataFrame, out: Path, *, drift_limit: float | None = None,
-                 period: float | None = None) -> Path:
-    """``report.md``: the counts, the fits against every IM, the period and the figures."""
+                 period: float | None = None, notes: Sequence[str] = ()) -> Path:
+    """``report.md``: the counts, the fits against every IM, the period, ``notes`` and the figures."""
     c = ida_counts(table)
     lines = ["# IDA and fragility", "", f"{c.line()}.", ""]
     if "stop_reason" in table:
@@ -503,11 +559,16 @@ def write_report(table: pd.DataFrame, fits: pd.DataFrame, out: Path, *, drift_li
         lines += ["Runs stopped once decided: " + ", ".join(f"{n} {r}" for r, n in reasons.items()) + ".", ""]
     lines += [f"Failure: overturned or collapsed{f', or peak rotation > {drift_limit:g} eta' if drift_limit else ''}.",
               f"Sa at T = {period:.4g} s (the block's rocking period 2 pi / p unless given), 5 % damping." if period else "",
+              *(["", "Cut short:", *[f"- {n}" for n in notes]] if notes else []),
               "", "| intensity measure | median theta | dispersion beta | runs |", "| --- | --- | --- | --- |"]
     for _, r in fits.iterrows():
         th = f"{r['theta']:.4g}" if np.isfinite(r["theta"]) else "not fitted"
         be = f"{r['beta']:.3g}" if np.isfinite(r["beta"]) else "-"
+        if np.isfinite(r["beta"]) and bool(r.get("separated", False)):
+            be += " (separated: not identifiable)"
         lines.append(f"| {r['label']} | {th} | {be} | {int(r['n'])} |")
+    if fits.get("separated", pd.Series(dtype=bool)).astype(bool).any():
+        lines += ["", SEPARATED_NOTE]
     lines += ["", "![IDA curves](ida.png)", "", "![fragility curves](fragility.png)", "", "![input spectra](spectra.png)", ""]
     p = out / "report.md"
     p.write_text("\n".join(lines))
@@ -517,7 +578,15 @@ def write_report(table: pd.DataFrame, fits: pd.DataFrame, out: Path, *, drift_li
 def _fragility_cli(args: argparse.Namespace) -> int:
     fixed = dict(parse_assignment(item) for item in args.set or [])
     lo, hi, n = args.pga
-    levels = np.linspace(float(lo), float(hi), int(n))
+    try:
+        lo, hi = float(lo), float(hi)
+        n = int(n)
+    except ValueError:
+        raise ValueError(f"--pga LOW HIGH N: LOW and HIGH are PGA levels [g] and N a whole count, got {' '.join(args.pga)}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo <= hi) or n < 1 or (n == 1 and lo != hi):
+        raise ValueError(f"--pga LOW HIGH N: give 0 < LOW <= HIGH [g] and N >= 1 levels (N = 1 with LOW = HIGH), "
+                         f"got {' '.join(args.pga)}")
+    levels = np.linspace(lo, hi, n)
     df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,
                        drift_limit=args.drift_limit, im=args.im, period=args.period, stop=args.stop,
                        executor=args.executor or "process", workers=args.workers,
@@ -526,8 +595,9 @@ def _fragility_cli(args: argparse.Namespace) -> int:
     if frag is None:
         print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did; widen the PGA range)")
     else:
-        print(f"fragility against {IM_COLUMNS[args.im]}: median {frag.theta:.4g}, dispersion {frag.beta:.4g}")
-    return 0
+        print(f"fragility against {IM_COLUMNS[args.im]}: median {frag.theta:.4g}, dispersion {frag.beta:.4g}"
+              + (" (separated outcomes: the dispersion is not identifiable, report.md)" if frag.separated else ""))
+    return 0 if ida_counts(df).errors == 0 else 1
 
 
 def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable[[argparse.ArgumentParser], None]) -> None:

@@ -281,8 +281,7 @@ class Store:
         p = Path(path)
         if p.suffix != ".jsonl":
             p = p / "runs.jsonl"
-        p.parent.mkdir(parents=True, exist_ok=True)
-        self.path = p
+        self.path = p  # its folder is made at the first row: a study refused before any run writes nothing
 
     def rows(self) -> list[dict[str, Any]]:
         """All stored rows, one per id (in first-finished order)."""
@@ -321,6 +320,7 @@ class Store:
                 fh.seek(-1, os.SEEK_END)
                 if fh.read(1) != b"\n":
                     line = "\n" + line
+        self.path.parent.mkdir(parents=True, exist_ok=True)
         with self.path.open("a", encoding="utf-8") as fh:
             fh.write(line)
             fh.flush()
@@ -733,6 +733,13 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
     except ValueError as exc:
         raise ValueError(f"[study] {exc}") from None
     _run_count(math.prod(len(p) for p in parts), "[study] grid x list x random")
+    seen: dict[str, str] = {key: "[study] set" for key in fixed}
+    for where, part in zip([n for n in ("grid", "list", "random") if n in s], parts):
+        for key in sorted({k for row in part for k in row}):
+            if key in seen:
+                raise ValueError(f"[study] {key!r} is given both in {seen[key]} and in [study.{where}]; "
+                                 "give each key in one place (the runs would silently take one of them)")
+            seen[key] = f"[study.{where}]"
     variations = [{}]
     for part in parts:
         variations = [{**a, **b} for a in variations for b in part]
@@ -802,7 +809,9 @@ def _sweep(args: argparse.Namespace) -> int:
             df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
                            progress=not args.no_progress)
     except KeyboardInterrupt:
-        print(f"rockdem sweep: stopped; the finished runs are kept in {Store(out).path} (rerun to resume)", file=sys.stderr)
+        path = Store(out).path
+        kept = f"the finished runs are kept in {path} (rerun to resume)" if path.exists() else "no run had finished (nothing kept)"
+        print(f"rockdem sweep: stopped; {kept}", file=sys.stderr)
         raise
     n_err = int((df["status"] == "error").sum()) if "status" in df else 0
     n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0

@@ -56,3 +56,15 @@ def test_a_better_point_outside_the_bounds_is_reported_not_taken(synthetic) -> N
     inside = res.evaluations[res.evaluations["damping.beta"] <= 1.05e-3]
     assert res.wme == inside["wme"].min()
     assert any("outside the bounds" in n for n in res.notes) and "widen the bounds" in res.report()
+
+
+@pytest.mark.parametrize("text", ["", "time,rotation\n", "0.1\n0.2\n", "# only a comment\n", "0.0,0.1\n"])
+def test_an_unusable_reference_file_is_refused_with_what_it_needs(tmp_path, text) -> None:
+    # an empty file, a header alone, one column or one row used to fail deep inside calibrate
+    p = tmp_path / "ref.csv"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=r"reference .*ref\.csv.*need rows of time \[s\] and value"):
+        cal.load_reference(p)
+    p.write_text("time,rotation\n0.0,0.1\n0.1,0.2\n")
+    ref = cal.load_reference(p)
+    assert list(ref.time) == [0.0, 0.1] and list(ref.value) == [0.1, 0.2]

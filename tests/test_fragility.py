@@ -7,7 +7,18 @@ import pandas as pd
 import pytest
 from scipy.stats import norm
 
-from rockdem.fragility import Fragility, collapse_capacities, fit_fragility_capacities, fit_fragility_mle, ida_counts, run_ida
+from rockdem.fragility import (
+    Fragility,
+    _cut_short,
+    collapse_capacities,
+    fit_all,
+    fit_fragility_capacities,
+    fit_fragility_mle,
+    ida_counts,
+    ida_specs,
+    run_ida,
+    write_report,
+)
 
 THETA, BETA = 0.4, 0.35  # median [g] and dispersion of the synthetic capacities
 
@@ -79,6 +90,32 @@ def test_small_ida_on_synthetic_pulse(tmp_path):
     fits = pd.read_csv(tmp_path / "ida" / "fragility.csv")
     assert list(fits["im"]) == ["pga_g", "pgv_m_s", "arias_m_s", "sa_g"] and (fits["n"] == 8).all()
     assert "| Sa(T) [g] |" in (tmp_path / "ida" / "report.md").read_text()
+
+
+def test_separated_outcomes_are_flagged_as_not_identifiable(tmp_path):
+    # Every failure above every survival: the likelihood grows as beta -> 0, so the fit's beta
+    # (0.008 here) says how far apart the levels are, not the dispersion. It is flagged.
+    im = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]
+    table = pd.DataFrame({"id": list("abcdef"), "status": "ok", "record": "r", "pga_g": im,
+                          "failed": [False, False, False, True, True, True]})
+    fits = fit_all(table)
+    assert bool(fits["separated"].iloc[0]) and fits["beta"].iloc[0] < 0.05
+    report = write_report(table, fits, tmp_path).read_text()
+    assert "(separated: not identifiable)" in report
+    mixed = table.assign(failed=[False, False, True, False, True, True])  # overlapping outcomes: a dispersion
+    fits = fit_all(mixed)
+    assert not bool(fits["separated"].iloc[0]) and fits["beta"].iloc[0] > 0.1
+    assert "not identifiable" not in write_report(mixed, fits, tmp_path).read_text()
+
+
+def test_runs_ending_before_their_record_s_strong_motion_are_noted(tmp_path):
+    # A 1 Hz sine pulse of 1 s peaks at 0.25 s and 0.75 s and has 95 % of its Arias intensity at
+    # about 0.95 s: runs of 0.85 s end before it (after the peaks), runs of 2 s after.
+    recs = _pulses(tmp_path, (1.0,))
+    notes = _cut_short(ida_specs("free-rocking", recs, [0.5], fixed=FIXED, duration=0.85))
+    assert len(notes) == 1 and "Arias intensity" in notes[0] and "its PGA" not in notes[0]
+    assert _cut_short(ida_specs("free-rocking", recs, [0.5], fixed=FIXED, duration=2.0)) == []
+    assert len(_cut_short(ida_specs("free-rocking", recs, [0.5], fixed=FIXED, duration=0.2))) == 1  # before the PGA too
 
 
 def _unreadable(tmp_path) -> str:

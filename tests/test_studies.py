@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import re
 import signal
 import subprocess
 import sys
@@ -191,6 +192,18 @@ def test_study_file_and_cli(tmp_path):
     assert len(df) == 4 and set(df["damping.alpha"]) == {2.0, 4.0}
     assert main(["sweep", str(f), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
     assert len((tmp_path / "out" / "runs.jsonl").read_text().splitlines()) == 4
+
+
+@pytest.mark.parametrize("tables,where", [
+    ('set = { "damping.alpha" = 3.0 }\n[study.grid]\n"damping.alpha" = [2.0, 4.0]', "[study] set"),
+    ('[study.list]\nrows = [{ "damping.alpha" = 2.0 }]\n[study.random]\n"damping.alpha" = [1.0, 3.0]', "[study.list]"),
+])
+def test_a_key_given_in_two_places_of_a_study_is_refused(tmp_path, tables, where):
+    # set and grid naming the same key: the grid used to win silently
+    f = tmp_path / "s.toml"
+    f.write_text('[study]\nbase = "free-rocking"\nduration = 0.5\n' + tables + "\n")
+    with pytest.raises(ValueError, match=rf"'damping.alpha' is given both in {re.escape(where)} and in"):
+        load_study(f)
 
 
 def test_calibration_recovers_beta_and_alpha(base):
