@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._warn import warn_user
 from .kernels.detect import bond_touching, detect, update_rotations
 from .kernels.layout import ENERGY_COUNT, FAILED_NONE, LAW_CHUNKS, SLOTS, Scratch, State
 from .model import Model
@@ -209,6 +210,11 @@ def detect_all(model: Model, s: State, sc: Scratch) -> tuple[State, Scratch]:
         s, sc = grow_buffers(s, sc)
 
 
+START_OVERLAP_SHARE = 0.1
+"""An overlap at the start above this share of the contact tolerance is warned about (the
+springs start loaded); above the tolerance itself it is refused."""
+
+
 def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, Scratch]:
     """State at t = 0 with contacts detected; joints touching at the start are bonded.
 
@@ -224,6 +230,13 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
         raise ValueError(
             f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.4g} m at the "
             f"start (tolerance {m.touch_tol:.3g} m); move them apart so that they at most touch"
+        )
+    if check_overlap and depth > START_OVERLAP_SHARE * m.touch_tol:
+        a, b = (int(v) for v in sc.min_pair)
+        warn_user(
+            f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.3g} m at the start: their "
+            "joint springs start compressed by that much and release its energy at the first steps (a 0.3 m cube "
+            "sunk 0.3 mm into the ground on kn = 5e9 Pa/m jumps 39 mm); move them apart so that they at most touch"
         )
     bond_touching(m, s, sc)
     return s, sc

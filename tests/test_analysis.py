@@ -303,3 +303,31 @@ def test_a_block_falling_off_a_stack_is_counted_as_fallen():
     assert re.search(r"fallen blocks +1 +of 2: .*\(top\)", text)
     assert re.search(r"analysed block +top +the largest rotation; its eta and overturning are its own", text)
     assert re.search(r"blocks past their eta +0 +of 2: at the end", text)  # it landed on a face
+
+
+def test_no_half_cycles_are_counted_below_the_rocking_onset() -> None:
+    # a block vibrating at 1e-4 of its eta (a joint's elastic ringing) never rocked: 0 half cycles,
+    # though the history has 40 peaks (a wall under a record used to read 68)
+    t = np.linspace(0.0, 2.0, 4001)
+    eta = 0.1
+    s = summarize(t, 1e-5 * np.sin(2 * np.pi * 10 * t), eta=eta)
+    assert s["onset_time_s"] is None and s["half_cycles"] == 0
+    s = summarize(t, 0.05 * np.sin(2 * np.pi * 1 * t), eta=eta)  # rocking at half its eta: counted
+    assert s["onset_time_s"] < 0.01 and s["half_cycles"] == 4
+
+
+def test_blocks_that_fell_off_the_supports_are_in_the_summary() -> None:
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+    from rockdem.run_cli import summary_lines
+    from rockdem.simulation import simulate
+
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e9, friction_angle=35)
+    b.add_box(1, 1, 0.3, base_center=(0, 0, -0.3), driven=True, name="ground")
+    b.add_box(0.2, 0.2, 0.2, base_center=(0.57, 0, 0), density=2000, name="overhanging")  # 3/4 over the edge
+    b.add_box(0.2, 0.2, 0.2, base_center=(0.0, 0, 0), density=2000, name="resting")
+    with pytest.warns(RuntimeWarning, match="fell off the edge"):
+        ds = simulate(b.finalize(damping=Damping(beta=1e-4)), 1.0, progress=False)
+    row = [line for line in summary_lines(ds) if "fell off the supports" in line]
+    assert len(row) == 1 and re.search(r"fell off the supports\s+1\s+of 2: .*\(overhanging at 0\.\d+ s\)", row[0])
