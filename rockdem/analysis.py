@@ -46,6 +46,7 @@ __all__ = [
     "result_eta",
     "eta_of",
     "FALL_FRACTION",
+    "TIPPED_ANGLE",
     "fallen_blocks",
     "is_free_rocking",
     "is_pushover",
@@ -576,6 +577,10 @@ def eta_of(attrs: Mapping[str, Any], block_eta: ArrayLike | None, block: int) ->
     return None
 
 
+TIPPED_ANGLE = 0.25 * np.pi
+"""A block whose vertical axis (of its reference pose) is tilted by more than this [rad] (45 deg) has fallen
+(:func:`fallen_blocks`): at rest it lies on another face or leans on something."""
+
 FALL_FRACTION = 0.5
 """A free block has fallen when its centroid dropped by this fraction of its smallest dimension
 (relative to the ground; :func:`fallen_blocks`, and the ``fell`` stop of :mod:`rockdem.stopping`)."""
@@ -585,6 +590,11 @@ def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
     """Ids of the free blocks of a rockdem result that have fallen by ``frame`` (default the last):
     their centroid is lower than at the first frame, relative to the ground's own vertical motion,
     by more than :data:`FALL_FRACTION` of the block's smallest dimension.
+
+    Or, with ``block_rotation`` (time, block, xyz; from the reference, untilted pose), whose
+    reference vertical axis is tilted by more than :data:`TIPPED_ANGLE` at ``frame``: it lies on
+    another face, or leans (a block toppled onto its side drops only (h - w) / 2, less than the
+    fraction for h < 2 w).
 
     Uses ``block_position (time, block, xyz)``, ``block_free``, ``vertex_local`` and
     ``block_vertex_start`` (the smallest extent of each block in its body frame), the ``gravity``
@@ -600,7 +610,15 @@ def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
     drop = (pos[0, free] - pos[frame, free]) @ up
     if "ground_displacement" in ds:
         drop = drop + float(np.asarray(ds["ground_displacement"].values[frame], dtype=float) @ up)
-    return free[drop > FALL_FRACTION * thickness]
+    fallen = drop > FALL_FRACTION * thickness
+    if "block_rotation" in ds:
+        # The tilt of the axis that was vertical in the block's reference (untilted) pose: for a
+        # rotation by theta about unit k, up . R up = cos theta + (k . up)^2 (1 - cos theta).
+        w = np.asarray(ds["block_rotation"].values[frame, free], dtype=float)  # (nf, 3) [rad]
+        theta = np.linalg.norm(w, axis=1)
+        k_up = (w @ up) / np.where(theta > 0.0, theta, 1.0)
+        fallen |= np.cos(theta) + k_up**2 * (1.0 - np.cos(theta)) < np.cos(TIPPED_ANGLE)
+    return free[fallen]
 
 
 def is_pushover(ds: Any) -> bool:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import signal
 import sys
@@ -17,7 +18,7 @@ import xarray as xr
 from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from .cli import EXIT_DIVERGED, hold_signals, positive_float, positive_int, stop_on_signals
-from .analysis import FALL_FRACTION, fallen_blocks
+from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
 from .loading import EQUILIBRIUM_TOLERANCE, load_carried
 from .results import export_csv, save, write_contact_table
 from .simulation import _deferred_signals, simulate
@@ -148,7 +149,8 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
                 lines.append(_row(f"failed in {mode}", f"{failed}", "", f"{100 * failed / npts:.1f} % of {npts} sub-contacts"))
         if len(free) > 1 and all(v in ds for v in ("block_position", "vertex_local", "block_vertex_start")):
             lines.append(_blocks_row("fallen blocks", ds, fallen_blocks(ds), len(free),
-                                     f"centroid dropped by over {FALL_FRACTION:g} of its smallest dimension"))
+                                     f"centroid dropped by over {FALL_FRACTION:g} of its smallest dimension, or tipped "
+                                     f"past {math.degrees(TIPPED_ANGLE):.0f} deg"))
         if a.get("fell_off_blocks"):
             names = [s.strip() for s in str(a["fell_off_blocks"]).split(",")]
             times = np.atleast_1d(np.asarray(a.get("fell_off_times", np.full(len(names), np.nan)), dtype=float))

@@ -331,3 +331,24 @@ def test_blocks_that_fell_off_the_supports_are_in_the_summary() -> None:
         ds = simulate(b.finalize(damping=Damping(beta=1e-4)), 1.0, progress=False)
     row = [line for line in summary_lines(ds) if "fell off the supports" in line]
     assert len(row) == 1 and re.search(r"fell off the supports\s+1\s+of 2: .*\(overhanging at 0\.\d+ s\)", row[0])
+
+
+def test_a_block_toppled_onto_its_side_has_fallen() -> None:
+    # 0.3 x 0.3 x 0.4 m released past its instability angle: it lands on its side, its centroid
+    # at most (0.4 - 0.3) / 2 = 0.05 m lower than untilted, a third of the drop criterion (half its
+    # 0.3 m): its tilt of 90 deg says it fell. The block beside it, standing, has not.
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+    from rockdem.simulation import simulate
+
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e9, friction_angle=35)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.3, 0.3, 0.4, base_center=(0, 0, 0), density=2000, name="toppled")
+    b.add_box(0.3, 0.3, 0.4, base_center=(0, 1, 0), density=2000, name="standing")
+    b.tilt("toppled", 1.1)  # 40.6 deg: past its eta = atan(0.3 / 0.4), not yet 45
+    ds = simulate(b.finalize(damping=Damping(beta=2e-4)), 1.5, progress=False)
+    z = ds.block_position.values[:, :, 2]
+    assert z[0, 1] - z[-1, 1] < 0.5 * 0.3  # the drop alone would not say it
+    assert list(ds.block_name.values[fallen_blocks(ds)]) == ["toppled"]
+    assert fallen_blocks(ds, frame=0).size == 0
