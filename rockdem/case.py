@@ -327,8 +327,9 @@ def joint_material(t: Table, *, spacing: float) -> JointMaterial:
 def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
     """A single rectangular block (width along x, the rocking direction) on a fixed foundation.
 
-    Keys: width, height, length [m], density [kg/m^3], points_across, points_along, and the
-    joint keys of :func:`joint_material` (with youngs_modulus, kn = E / height).
+    Keys: width, height, length [m], density [kg/m^3], points_across, points_along,
+    foundation_extent [m] (plan size of the foundation; default twice the block's largest
+    dimension), and the joint keys of :func:`joint_material` (with youngs_modulus, kn = E / height).
     """
     width = t.number("width", positive=True)
     height = t.number("height", positive=True)
@@ -337,7 +338,8 @@ def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
     pts = t.points()
     mat = joint_material(t, spacing=height)
     b.default_material = mat
-    size = 2.0 * max(width, length, height)
+    extent = t.optional_number("foundation_extent", positive=True)
+    size = 2.0 * max(width, length, height) if extent is None else extent
     b.add_box(size, size, 0.25 * size, base_center=(0.0, 0.0, -0.25 * size), driven="ground", group="foundation", name="foundation", points=(2, 2))
     b.add_box(width, length, height, density=density, name="block", points=pts)
     return {"top": ("block", (0.5 * width, 0.0, height))}

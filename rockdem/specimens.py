@@ -718,7 +718,8 @@ def _sub_material(t: Table, key: str, *, spacing: float) -> JointMaterial | None
 @specimen("stack")
 def _stack_case(t: Table, b: ModelBuilder) -> Monitors:
     """Stacked blocks. Keys: width, length, heights (list) [m], density, points_across,
-    points_along and the joint keys (youngs_modulus: kn = E / mean block height)."""
+    points_along, foundation_extent [m] (plan size of the foundation; default sized for collapse) and
+    the joint keys (youngs_modulus: kn = E / mean block height)."""
     heights = [float(v) for v in t.numbers("heights", positive=True)]
     _block_count(f"[{t.where}] heights ({len(heights)} entries)", len(heights))
     width = t.number("width", positive=True)
@@ -726,14 +727,16 @@ def _stack_case(t: Table, b: ModelBuilder) -> Monitors:
     density = t.number("density", 1800.0, positive=True)
     pts = t.points()
     mat = joint_material(t, spacing=sum(heights) / len(heights))
-    return stacked_blocks(b, width=width, length=length, heights=heights, density=density, material=mat, points=pts)
+    return stacked_blocks(b, width=width, length=length, heights=heights, density=density, material=mat, points=pts,
+                          foundation_extent=t.optional_number("foundation_extent", positive=True))
 
 
 @specimen("wall")
 def _wall_case(t: Table, b: ModelBuilder) -> Monitors:
     """Brick wall. Keys: brick = [lx, ly, lz] [m], courses, bricks_per_course, bond, density,
-    points_across, points_along, base_reduction [m], [joint] (bed/head joints, kn = E / lz) and
-    optional [base] (base joint; default the joint's)."""
+    points_across, points_along, base_reduction [m], foundation_extent [m] (plan size of the
+    foundation; default sized for collapse), [joint] (bed/head joints, kn = E / lz) and optional
+    [base] (base joint; default the joint's)."""
     brick = t.vector("brick", (0.11, 0.23, 0.076))
     kw = dict(
         brick=tuple(float(v) for v in brick),
@@ -748,13 +751,15 @@ def _wall_case(t: Table, b: ModelBuilder) -> Monitors:
         raise ValueError(f"[{t.where}] the [joint] sub-table (bed and head joint material) is required")
     joint = _sub_material(t, "joint", spacing=float(brick[2]))
     base = _sub_material(t, "base", spacing=float(brick[2]))
-    return brick_wall(b, joint=joint, base=base, **kw)  # type: ignore[arg-type]
+    return brick_wall(b, joint=joint, base=base, foundation_extent=t.optional_number("foundation_extent", positive=True),
+                      **kw)  # type: ignore[arg-type]
 
 
 @specimen("parapet")
 def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
     """Parapet. Keys: thickness, height, length, base_reduction [m], density, brick = [ly, lz]
-    (absent: single block "parapet"), bond, points_across, points_along, the joint keys
+    (absent: single block "parapet"), bond, points_across, points_along, foundation_extent [m]
+    (plan size of the foundation; default sized for collapse), the joint keys
     (kn = E / height, or E / brick height when discretised) and optional [base] (the base joint;
     default the joint keys' material)."""
     thickness = t.number("thickness", 0.23, positive=True)
@@ -778,6 +783,7 @@ def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
         material=mat,
         base_material=_sub_material(t, "base", spacing=spacing),
         points=pts,
+        foundation_extent=t.optional_number("foundation_extent", positive=True),
     )
 
 
@@ -786,7 +792,7 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
     """One-sided façade. Keys: width, height, length, return_thickness, return_length,
     return_height, gap, edge_radius [m], edge_facets, slope_deg, rocking_velocity [rad/s],
     density, brick = [ly, lz] (absent: single block "facade"), bond, points_across, points_along,
-    the joint keys (kn = E / height, or E / course height when discretised) and optional [return]
+    foundation_extent [m] (plan size of the foundation; default sized for collapse), the joint keys (kn = E / height, or E / course height when discretised) and optional [return]
     (façade-return wall contact)."""
     height = t.number("height", 0.8, positive=True)
     brick = tuple(float(v) for v in t.vector("brick", size=2)) if "brick" in t.data else None
@@ -813,6 +819,7 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
         rocking_velocity=t.number("rocking_velocity", 0.0),
         brick=brick,  # type: ignore[arg-type]
         bond=t.string("bond", "running", choices=BONDS),
+        foundation_extent=t.optional_number("foundation_extent", positive=True),
     )
 
 
@@ -820,7 +827,8 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
 def _two_block_case(t: Table, b: ModelBuilder) -> Monitors:
     """Two-block wall. Keys: thickness, height, length, crack_height, rod_size, rod_height, rod_gap,
     push_displacement [m], push_time, hold_time [s], withdraw_speed [m/s], density,
-    points_across, points_along, the joint keys (kn = E / (H/2)) and optional [rod]."""
+    points_across, points_along, foundation_extent [m] (plan size of the foundation; default sized
+    for collapse), the joint keys (kn = E / (H/2)) and optional [rod]."""
     height = t.number("height", 1.5, positive=True)
     mat = joint_material(t, spacing=0.5 * height)
     rod_t = "rod" in t.data
@@ -843,4 +851,5 @@ def _two_block_case(t: Table, b: ModelBuilder) -> Monitors:
         hold_time=t.number("hold_time", 0.1, min_=0.0),
         withdraw_speed=t.number("withdraw_speed", 1.0, positive=True),
         points=t.points(),
+        foundation_extent=t.optional_number("foundation_extent", positive=True),
     )
