@@ -257,7 +257,7 @@ def _check_cases(specs: Sequence[RunSpec], per_record: int) -> None:
             first = first or exc
     if first is not None:
         n = len(specs) // per_record
-        raise ValueError(f"no run of the IDA can start ({'its record' if n == 1 else f'none of its {n} records'} gives a "
+        raise ValueError(f"no run of the IDA can start ({'its record gives no' if n == 1 else f'none of its {n} records gives a'} "
                          f"valid case; nothing was run): {first}")
 
 

@@ -364,7 +364,7 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("case", nargs="?", help="TOML case file")
     p.add_argument("--example", help=f"built-in example ({', '.join(example_names())})")
     p.add_argument("--list-examples", action="store_true", help="list the built-in examples")
-    p.add_argument("--out", help="output directory (default results/<case name>)")
+    p.add_argument("--out", "-o", help="output directory (default results/<case name>)")
     p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE", help="override a case value")
     p.add_argument("--duration", type=positive_float, help="simulated time [s], overrides [run] duration")
     p.add_argument("--stop", choices=STOP_MODES, default=None,
