@@ -515,7 +515,7 @@ def summarize(
         out["exceeded_eta"] = bool(max_rotation(th) > eta)
         out["overturned"] = overturned(th, eta)
         th0 = abs(float(pk.value[0])) if len(pk.value) else 0.0
-        if free_rocking and len(pk.value) >= 2 and 0.0 < th0 < eta:
+        if free_rocking and out["onset_time_s"] is not None and len(pk.value) >= 2 and 0.0 < th0 < eta:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ea = apparent_restitution(pk.value[1:], th0, eta)
@@ -591,10 +591,12 @@ def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
     their centroid is lower than at the first frame, relative to the ground's own vertical motion,
     by more than :data:`FALL_FRACTION` of the block's smallest dimension.
 
-    Or, with ``block_rotation`` (time, block, xyz; from the reference, untilted pose), whose
-    reference vertical axis is tilted by more than :data:`TIPPED_ANGLE` at ``frame``: it lies on
-    another face, or leans (a block toppled onto its side drops only (h - w) / 2, less than the
-    fraction for h < 2 w).
+    The drop is measured from the reference (untilted) pose, ``block_position_reference``, where
+    present (results before 2026-11-27: from the first frame). Or, with ``block_rotation`` (time,
+    block, xyz; from the reference pose), whose reference vertical axis is tilted by more than
+    :data:`TIPPED_ANGLE`, or by more than its own ``block_eta`` for a squat block, at ``frame``: it
+    lies on another face, or leans (a block toppled onto its side drops only (h - w) / 2, less than
+    the fraction for h < 2 w).
 
     Uses ``block_position (time, block, xyz)``, ``block_free``, ``vertex_local`` and
     ``block_vertex_start`` (the smallest extent of each block in its body frame), the ``gravity``
@@ -607,7 +609,9 @@ def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
     v = np.asarray(ds["vertex_local"].values, dtype=float)
     thickness = np.array([float(np.ptp(v[start[b]:start[b + 1]], axis=0).min()) for b in free])
     pos = np.asarray(ds["block_position"].values, dtype=float)
-    drop = (pos[0, free] - pos[frame, free]) @ up
+    # from the reference pose: a tilted release starts raised, and an assembly back upright has not fallen
+    ref = np.asarray(ds["block_position_reference"].values, dtype=float)[free] if "block_position_reference" in ds else pos[0, free]
+    drop = (ref - pos[frame, free]) @ up
     if "ground_displacement" in ds:
         drop = drop + float(np.asarray(ds["ground_displacement"].values[frame], dtype=float) @ up)
     fallen = drop > FALL_FRACTION * thickness
@@ -617,7 +621,9 @@ def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
         w = np.asarray(ds["block_rotation"].values[frame, free], dtype=float)  # (nf, 3) [rad]
         theta = np.linalg.norm(w, axis=1)
         k_up = (w @ up) / np.where(theta > 0.0, theta, 1.0)
-        fallen |= np.cos(theta) + k_up**2 * (1.0 - np.cos(theta)) < np.cos(TIPPED_ANGLE)
+        eta = np.asarray(ds["block_eta"].values, dtype=float)[free] if "block_eta" in ds else np.zeros(free.size)
+        limit = np.maximum(TIPPED_ANGLE, np.nan_to_num(eta))  # a squat block may stand tilted up to its eta
+        fallen |= np.cos(theta) + k_up**2 * (1.0 - np.cos(theta)) < np.cos(limit)
     return free[fallen]
 
 

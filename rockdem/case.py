@@ -8,6 +8,7 @@ in :data:`LOADINGS`. Units: SI, angles in degrees where the key says ``_deg``.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import dataclasses
 import json
@@ -15,10 +16,11 @@ import math
 import os
 import threading
 import tomllib
+import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any, Callable, Iterator, Mapping
 
 import numpy as np
 
@@ -339,6 +341,9 @@ def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
     mat = joint_material(t, spacing=height)
     b.default_material = mat
     extent = t.optional_number("foundation_extent", positive=True)
+    if extent is not None and extent < max(width, length):
+        raise ValueError(f"[{t.where}] foundation_extent = {extent:g} m is smaller than the block's footprint "
+                         f"({width:g} x {length:g} m); give at least {max(width, length):g} m")
     size = 2.0 * max(width, length, height) if extent is None else extent
     b.add_box(size, size, 0.25 * size, base_center=(0.0, 0.0, -0.25 * size), driven="ground", group="foundation", name="foundation", points=(2, 2))
     b.add_box(width, length, height, density=density, name="block", points=pts)
@@ -600,8 +605,9 @@ class CaseTemplate:
         ctx = _loading(top, builder, monitors, run)
         output = _output(top)
         top.finish()
-        model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis"),
-                                 contact_tolerance=run.contact_tolerance)
+        with _chosen_damping(data):
+            model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis"),
+                                     contact_tolerance=run.contact_tolerance)
         self._ctx = ctx
         self._builder = builder  # what an automatic beta is resolved on
         self._choices: dict[Damping, BetaChoice] = {damping: model.beta_choice} if model.beta_choice is not None else {}
@@ -635,16 +641,30 @@ class CaseTemplate:
         if self._swap:
             builder, monitors = copy.copy(self._bare), dict(self._monitors)
             ctx = _loading(top, builder, monitors, run)
-            model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
+            with _chosen_damping(data):
+                model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
             axis = np.asarray(ctx.get("rocking_axis", builder.default_rocking_axis()), dtype=float)  # the load's own direction
             model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
         else:
             top.used.add("loading")
             ctx, monitors = self._ctx, dict(self.case.monitors)
-            model = model.with_inputs(damping=damping, beta_choice=self.beta_choice(damping))
+            with _chosen_damping(data):
+                model = model.with_inputs(damping=damping, beta_choice=self.beta_choice(damping))
         output = _output(top)
         top.finish()
         return Case(name, model, run, monitors, output, dict(data), dict(ctx["attrs"]), dict(ctx["series"]))
+
+
+@contextlib.contextmanager
+def _chosen_damping(data: Mapping[str, Any]) -> Iterator[None]:
+    """Within the block, no warning about an undamped model when the case's ``[damping]`` states
+    alpha or beta itself (``beta = 0.0``: an undamped model by choice, e.g. the paper's
+    discretised non-damped strategy, §3.2); without them it warns (model._warn_implausible_damping)."""
+    table = data.get("damping")
+    with warnings.catch_warnings():
+        if isinstance(table, Mapping) and ("beta" in table or "alpha" in table):
+            warnings.filterwarnings("ignore", message="no damping", category=UserWarning)
+        yield
 
 
 _AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")

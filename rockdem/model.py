@@ -282,7 +282,6 @@ class Model:
                     "beta_choice=rockdem.targeting.choose_beta(builder, model, damping) or use ModelBuilder.finalize"
                 )
             fields.update(damping_arrays(self.materials, self.group_names, damping, beta_choice))
-            _warn_implausible_damping(self, damping)
             new_damping = damping if beta_choice is None else replace(damping, beta=beta_choice.beta)
             choice = beta_choice
         elif beta_choice is not None:
@@ -291,7 +290,10 @@ class Model:
             if tuple(builder.block_names()) != self.block_names:
                 raise ValueError("with_inputs: the builder's blocks are not this model's")
             fields.update(builder.input_arrays())
-        return replace(self, arrays=self.arrays._replace(**fields), damping=new_damping, beta_choice=choice)
+        model = replace(self, arrays=self.arrays._replace(**fields), damping=new_damping, beta_choice=choice)
+        if damping is not None:
+            _warn_implausible_damping(model, damping)
+        return model
 
     def summary(self) -> dict[str, str]:
         """Short description, label -> text: blocks, points, groups, joints, damping, loading, size."""
@@ -1023,7 +1025,8 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
     omega = np.sqrt(softest * extents[:, 0] * extents[:, 1] / m.block_mass[free])
     k = int(np.argmin(omega))
     critical = 2.0 / float(omega[k])
-    if beta == 0.0 and damping.alpha == 0.0 and damping.local == 0.0 and g > 0.0 and math.isfinite(critical):
+    undamped = beta == 0.0 and damping.alpha == 0.0 and damping.local == 0.0 and not np.any(m.mat_beta > 0.0)  # joints' own beta too
+    if undamped and g > 0.0 and math.isfinite(critical):
         warn_user(
             "no damping (alpha = beta = 0): the joints' elastic vibration, started as gravity loads them, never "
             "decays; a block held by friction near its limit (on a slope, in a wedge) creeps at every cycle (1 mm/s "

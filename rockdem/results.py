@@ -13,6 +13,7 @@ Variables (dims; units in each variable's ``units`` attribute):
   block_displacement (time, block, xyz) [m]    centroid displacement from t = 0, relative to the
                                                ground (attr ``reference``; see below)
   block_displacement_absolute (time, block, xyz) [m]  the same in the model's fixed frame
+  block_position_reference (block, xyz) [m]    centroid in the reference pose (before any initial tilt)
   block_rotation (time, block, xyz) [rad]      rotation vector of R(t) R_ref^T (world); R_ref is the
                                                orientation before any initial tilt
   rocking_angle (time, block) [rad]            block_rotation . rocking_axis
@@ -170,6 +171,8 @@ def build_dataset(
     ds["ground_displacement"] = (("time", "xyz"), u_ground, {"units": "m", "note": "driven='ground' blocks"})
     ds["block_displacement"] = (xyz, u_abs - u_ground[:, None], {"units": "m", "reference": ref, "note": rel_note})
     ds["block_displacement_absolute"] = (xyz, u_abs, {"units": "m", "reference": "fixed frame", "note": abs_note})
+    ds["block_position_reference"] = (("block", "xyz"), model.position_ref,
+                                      {"units": "m", "note": "centroid in the reference pose, before any initial tilt"})
     ds["block_rotation"] = (xyz, rotvec, {"units": "rad"})
     ds["rocking_angle"] = (("time", "block"), rocking_angles(model, rotvec), {"units": "rad", "axis": axis.tolist()})
     names = list(monitors)

@@ -107,6 +107,20 @@ def collapse_extent(width: float, length: float, height: float) -> float:
     return max(width, length) + 3.0 * height
 
 
+def _foundation_size(given: float | None, width: float, length: float, height: float) -> float:
+    """The foundation's plan size [m]: ``given`` (a specimen's ``foundation_extent``), at least its
+    footprint ``width`` x ``length`` [m] (a smaller one would leave the specimen overhanging, or on
+    a pedestal it sinks into), else :func:`collapse_extent`."""
+    if given is None:
+        return collapse_extent(width, length, height)
+    size = _positive("foundation_extent", given)
+    if size < max(width, length):
+        raise ValueError(f"foundation_extent = {size:g} m is smaller than the specimen's footprint ({width:g} x {length:g} m): "
+                         f"give at least {max(width, length):g} m, and for collapse collapse_extent = "
+                         f"{collapse_extent(width, length, height):g} m (the default)")
+    return size
+
+
 def add_foundation(builder: ModelBuilder, extent: float, *, name: str = "foundation") -> int:
     """Add a driven ``"ground"`` box (group ``"foundation"``) whose top face is z = 0.
 
@@ -210,7 +224,7 @@ def stacked_blocks(
     _positive("density", density, "kg/m^3")
     material = _material("material", material)
     if foundation:
-        add_foundation(builder, collapse_extent(w, ln, sum(hs)) if foundation_extent is None else foundation_extent)
+        add_foundation(builder, _foundation_size(foundation_extent, w, ln, sum(hs)))
     _set_pairs(builder, [("block", "block"), ("block", "foundation"), ("foundation", "foundation")], material)
     monitors: Monitors = {}
     z = 0.0
@@ -314,7 +328,7 @@ def brick_wall(
     width = nb * ly
     height = nc * lz
     if foundation:
-        add_foundation(builder, collapse_extent(lx, width, height) if foundation_extent is None else foundation_extent)
+        add_foundation(builder, _foundation_size(foundation_extent, lx, width, height))
     _set_pairs(builder, [("brick", "brick")], joint)
     _set_pairs(builder, [("brick", "foundation"), ("foundation", "foundation")], base if base is not None else joint)
     pts = (int(points[0]), int(points[1]))
@@ -417,7 +431,7 @@ def parapet(
             base_reduction=red,
             foundation_extent=foundation_extent,
         )
-    add_foundation(builder, collapse_extent(t, ln, h) if foundation_extent is None else foundation_extent)
+    add_foundation(builder, _foundation_size(foundation_extent, t, ln, h))
     _set_pairs(builder, [("block", "block"), ("foundation", "foundation")], material)
     _set_pairs(builder, [("block", "foundation")], material if base_material is None else base_material)
     poly = rounded_prism(t, ln, h, chamfer=0.5 * red, name="parapet") if red > 0 else box(t, ln, h, center=(0, 0, 0.5 * h), name="parapet")
@@ -528,7 +542,7 @@ def facade(
             f"slope_deg = {slope_deg} leans the façade into the return walls (top moves "
             f"{inner_top[0] - 0.5 * b:.4g} m inward, gap {g} m); use a smaller inward slope or a larger gap"
         )
-    fid = add_foundation(builder, collapse_extent(b + g + lr, ln, h) if foundation_extent is None else foundation_extent)
+    fid = add_foundation(builder, _foundation_size(foundation_extent, b + g + lr, ln, h))
     groups = [("facade", "foundation"), ("facade", "facade"), ("foundation", "foundation"), ("return", "return"), ("return", "foundation")]
     _set_pairs(builder, groups, material)
     _set_pairs(builder, [("facade", "return"), ("brick", "return")], return_material if return_material is not None else material)
@@ -679,7 +693,7 @@ def two_block_wall(
         raise ValueError(f"push_displacement ({d0} m) must be below the thickness ({t} m) or the wall overturns")
     if d0 > 0 and not (0.5 * s < hc and hc + 0.5 * s < zr - 0.5 * s):
         raise ValueError(f"rod_size ({s} m) is too large for a pushing rod at the crack ({hc} m)")
-    add_foundation(builder, collapse_extent(t, ln, h) if foundation_extent is None else foundation_extent)
+    add_foundation(builder, _foundation_size(foundation_extent, t, ln, h))
     _set_pairs(builder, [("wall", "wall"), ("wall", "foundation"), ("foundation", "foundation")], material)
     if rod_material is None:
         base = material if material is not None else builder.default_material

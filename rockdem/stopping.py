@@ -293,7 +293,8 @@ class Stopper:
         dz_ground = np.zeros(hi - lo)
         if self.ground >= 0:
             dz_ground = (rec.position[lo:hi, self.ground] - self.model.position0[self.ground]) @ up
-        drop = (self.model.position0[self.free] - rec.position[lo:hi][:, self.free]) @ up + dz_ground[:, None]
+        # from the reference pose: a tilted release starts raised (analysis.fallen_blocks)
+        drop = (self.model.position_ref[self.free] - rec.position[lo:hi][:, self.free]) @ up + dz_ground[:, None]
         fallen = drop > FALL_FRACTION * self.thickness[self.free]
         frames = np.flatnonzero(fallen.any(axis=1))
         if not frames.size:

@@ -352,3 +352,28 @@ def test_a_block_toppled_onto_its_side_has_fallen() -> None:
     assert z[0, 1] - z[-1, 1] < 0.5 * 0.3  # the drop alone would not say it
     assert list(ds.block_name.values[fallen_blocks(ds)]) == ["toppled"]
     assert fallen_blocks(ds, frame=0).size == 0
+
+
+def test_a_tilted_squat_stack_back_upright_has_not_fallen() -> None:
+    # Released tilted, its blocks start raised; back upright they are lower than at the first frame
+    # by more than the drop criterion, but at their reference (untilted) height: not fallen.
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+    from rockdem.simulation import simulate
+    from rockdem.specimens import stacked_blocks
+
+    b = ModelBuilder()
+    stacked_blocks(b, width=1.0, length=1.0, heights=[0.15, 0.15], material=JointMaterial(kn=1e9, friction_angle=35))
+    b.tilt(["block1", "block2"], 0.9)
+    ds = simulate(b.finalize(damping=Damping(beta=2e-3)), 1.5, progress=False)
+    z = ds.block_position.values[:, :, 2]
+    free = np.flatnonzero(ds.block_free.values)
+    assert np.all(z[0, free] - z[-1, free] > 0.5 * 0.15)  # the old criterion's fall
+    assert abs(float(ds.rocking_angle.values[-1, free[0]])) < 1e-3  # back upright
+    assert fallen_blocks(ds).size == 0
+
+
+def test_no_restitution_is_reported_without_rocking() -> None:
+    t = np.linspace(0.0, 2.0, 4001)
+    s = summarize(t, 1e-4 * np.exp(-t) * np.abs(np.cos(2 * np.pi * 2 * t)), eta=0.2)  # peaks below 1 % of eta
+    assert s["onset_time_s"] is None and "e_a_mean" not in s and s["half_cycles"] == 0

@@ -381,5 +381,6 @@ def test_case_files_take_the_foundation_extent(example):
     start = model.arrays.block_vertex_start
     extent = np.ptp(model.arrays.vertex_local[start[f]:start[f + 1]], axis=0)
     np.testing.assert_allclose(extent[:2], 7.5, rtol=1e-12)
-    with pytest.raises(ValueError, match="foundation_extent"):
-        parse_case(apply_overrides(data, ["specimen.foundation_extent=-1"]))
+    for bad in ("-1", "0.05"):  # 0.05 m: smaller than the specimen's footprint, a pedestal it would sink into
+        with pytest.raises(ValueError, match="foundation_extent"):
+            parse_case(apply_overrides(data, [f"specimen.foundation_extent={bad}"]))

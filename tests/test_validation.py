@@ -93,6 +93,29 @@ def test_an_undamped_model_is_warned_about_its_ringing_joints():
     assert notes == [] and held < 1e-5  # the elastic shear deflection, a few micrometres
 
 
+def test_the_undamped_warning_stays_quiet_for_damped_joints_and_an_undamped_case_by_choice():
+    def block(material_beta):
+        b = ModelBuilder()
+        b.default_material = JointMaterial(kn=2e9, friction_angle=30, beta=material_beta)
+        b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+        b.add_box(0.3, 0.3, 0.6, density=2000, name="block")
+        return b
+
+    with pytest.warns(UserWarning, match="no damping"):
+        block(0.0).finalize()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        block(1e-4).finalize()  # the joints' own SP damping
+    data = example_case("free-rocking")
+    data["damping"] = {"beta": 0.0}  # stated: the paper's non-damped strategy (§3.2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parse_case(data)
+    del data["damping"]
+    with pytest.warns(UserWarning, match="no damping"):
+        parse_case(data)
+
+
 def test_dt_above_the_stable_bound_is_refused_with_the_bound():
     model = rocking_block(damping=Damping(beta=0.00693))
     bound = stable_timestep(model).critical
