@@ -16,9 +16,9 @@ results are robust shows up there as a much larger sensitivity for ``damping.alp
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -31,7 +31,6 @@ import pandas as pd
 
 from .analysis import wme
 from .plots import save_figure
-from .batch import batch_row
 from .case import parse_assignment
 from .studies import RunSpec, Store, check_first_run, execute, resolve_base, with_stop
 
@@ -61,6 +60,8 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
     displacement). Otherwise a CSV/text file of time and value columns (header lines skipped).
     """
     p = Path(path)
+    if p.is_dir():
+        raise ValueError(f"reference {p} is a folder; give a CSV or text file of time and value, or a rockdem result .nc")
     if not p.is_file():
         raise FileNotFoundError(f"reference {p} does not exist")
     if quantity not in QUANTITIES:
@@ -68,7 +69,10 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
     if p.suffix == ".nc":
         from .results import load
 
-        ds = load(p)
+        try:
+            ds = load(p)
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"reference {p}: not a rockdem result ({exc})") from None
         t = np.asarray(ds.time.values, dtype=float)
         if quantity == "rotation":
             b = int(np.flatnonzero(ds.block_free.values)[0])
@@ -76,17 +80,26 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         else:
             x = np.asarray(ds.monitor_displacement.values[:, 0, 0], dtype=float)
         return Reference(t, x, quantity)
-    need = f"need rows of time [s] and value (column {column}, zero-based), separated by commas, spaces or tabs"
+    need = f"need rows of time [s] and value (column {column}, zero-based), separated by commas, semicolons, spaces or tabs"
     try:
-        df = pd.read_csv(p, sep=None, engine="python", header=None, comment="#")
-    except (pd.errors.EmptyDataError, pd.errors.ParserError, csv.Error) as exc:
-        raise ValueError(f"reference {p}: cannot be read as a table ({exc}); {need}") from None
-    df = df.apply(pd.to_numeric, errors="coerce").dropna()
-    if df.shape[1] <= column:
-        raise ValueError(f"reference {p}: {need}; found {df.shape[1]} column(s)")
-    if len(df) < 2:
-        raise ValueError(f"reference {p}: {len(df)} numeric row(s); {need}, at least two rows")
-    return Reference(df.iloc[:, 0].to_numpy(float), df.iloc[:, column].to_numpy(float), quantity)
+        text = p.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError:
+        raise ValueError(f"reference {p}: not a text file; {need}") from None
+    rows, widths = [], set()
+    for line in text.splitlines():
+        fields = [f for f in re.split(r"[,;\s]+", line.split("#", 1)[0].strip()) if f]
+        try:
+            values = [float(f) for f in fields]
+        except ValueError:
+            continue  # a header or a note
+        if values:
+            widths.add(len(values))
+            rows.append(values)
+    if rows and min(widths) <= column:
+        raise ValueError(f"reference {p}: {need}; found {min(widths)} column(s)")
+    if len(rows) < 2:
+        raise ValueError(f"reference {p}: {len(rows)} numeric row(s); {need}, at least two rows")
+    return Reference(np.array([r[0] for r in rows]), np.array([r[column] for r in rows]), quantity)
 
 
 def reference_from_row(row: Mapping[str, Any], quantity: str = "rotation") -> Reference:
@@ -238,10 +251,7 @@ def calibrate(
     def objective(x: Sequence[float]) -> float:
         v = to_v(np.atleast_1d(x))
         v = [min(max(vi, b[0]), b[1]) for vi, b in zip(v, bnds)]
-        s = spec(v)
-        if s.id not in cache:
-            record(s, batch_row(s), v)
-        return cache[s.id]
+        return batch([v])[0]  # one run, serial, through the store (a rerun reuses it)
 
     lo, hi = to_x([b[0] for b in bnds]), to_x([b[1] for b in bnds])
     if len(keys) == 1:

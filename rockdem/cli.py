@@ -52,6 +52,9 @@ class Interrupted(KeyboardInterrupt):
         super().__init__(signal.Signals(signum).name)
         self.signum = signum
 
+    def __reduce__(self) -> tuple[type, tuple[int]]:  # pickled by its number (from a pool or Dask worker)
+        return (Interrupted, (self.signum,))
+
 
 def exit_status(exc: KeyboardInterrupt) -> int:
     """128 + the signal number of an interruption (130 for a plain Ctrl-C)."""

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -225,13 +226,13 @@ def fit_all(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def separated(im: Sequence[float], failed_: Sequence[bool]) -> bool:
-    """Whether the outcomes are completely separated by the intensity: every failure above every
-    survival. The likelihood then grows as the dispersion goes to 0, so the fitted beta only
+    """Whether the outcomes are separated by the intensity: every failure at or above every
+    survival (records sharing their levels tie at the boundary: quasi-complete separation). The likelihood then grows as the dispersion goes to 0, so the fitted beta only
     says how far apart the levels were, not the record-to-record dispersion: more records, or
     levels between the last survival and the first failure, are needed."""
     x = np.asarray(im, dtype=float)
     z = np.asarray(failed_, dtype=bool)
-    return bool(z.any() and (~z).any() and x[~z].max() < x[z].min())
+    return bool(z.any() and (~z).any() and x[~z].max() <= x[z].min())  # ties at one level too (quasi-complete)
 
 
 def characteristic_period(specs: Sequence[RunSpec]) -> float | None:
@@ -280,7 +281,7 @@ def _cut_short(specs: Sequence[RunSpec]) -> list[str]:
         except (ValueError, FileNotFoundError, OSError):
             continue  # its runs error, reported apart
         a2 = np.cumsum(np.asarray(gm.acceleration, dtype=float) ** 2)
-        t = float(load.get("delay", 0.0)) + gm.start_time + gm.dt * np.arange(a2.size)
+        t = float(load.get("delay", 0.0)) + gm.dt * np.arange(a2.size)  # the run applies it from its delay (a window too)
         t_strong = float(t[np.searchsorted(a2, STRONG_MOTION_SHARE * a2[-1])])
         t_peak = float(t[int(np.argmax(np.abs(gm.acceleration)))])
         missed = [what for what, at in ((f"{STRONG_MOTION_SHARE:.0%} of its Arias intensity has arrived ({t_strong:.3g} s)", t_strong),
@@ -587,10 +588,19 @@ def _fragility_cli(args: argparse.Namespace) -> int:
         raise ValueError(f"--pga LOW HIGH N: give 0 < LOW <= HIGH [g] and N >= 1 levels (N = 1 with LOW = HIGH), "
                          f"got {' '.join(args.pga)}")
     levels = np.linspace(lo, hi, n)
-    df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,
-                       drift_limit=args.drift_limit, im=args.im, period=args.period, stop=args.stop,
-                       executor=args.executor or "process", workers=args.workers,
-                       scheduler=args.scheduler, progress=not args.no_progress)
+    from .cli import stop_on_signals
+
+    try:
+        with stop_on_signals():  # SIGTERM and SIGHUP stop it and its workers as Ctrl-C does
+            df, frag = run_ida(args.base, args.records, levels, args.out, fixed=fixed, duration=args.duration,
+                               drift_limit=args.drift_limit, im=args.im, period=args.period, stop=args.stop,
+                               executor=args.executor or "process", workers=args.workers,
+                               scheduler=args.scheduler, progress=not args.no_progress)
+    except KeyboardInterrupt:
+        path = Store(args.out).path
+        kept = f"the finished runs are kept in {path} (rerun to resume)" if path.exists() else "no run had finished (nothing kept)"
+        print(f"rockdem fragility: stopped; {kept}", file=sys.stderr)
+        raise
     print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}, report.md")
     if frag is None:
         print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did; widen the PGA range)")

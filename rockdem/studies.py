@@ -123,6 +123,13 @@ class RunSpec:
         if overrides is not None and not isinstance(overrides, Mapping):
             raise ValueError(f"overrides must be a mapping of 'table.key' to values, got {overrides!r}"[:200])
         items = tuple(sorted((str(k), _plain(v)) for k, v in (overrides or {}).items()))
+        given = {k for k, _ in items}
+        for arg, keys in (("duration", ("run.duration",)), ("record", ("loading.record",)),
+                          ("pga_g", ("loading.pga_g", "loading.scale"))):
+            clash = sorted(given.intersection(keys)) if kwargs.get(arg) is not None else []
+            if clash:
+                raise ValueError(f"{clash[0]} is set by an override and by the study's own {arg} "
+                                 f"({kwargs[arg]!r}); the spec would silently take one of them: give it in one place")
         for key in ("duration", "pga_g", "history_interval"):
             if kwargs.get(key) is not None:
                 kwargs[key] = _positive(kwargs[key], key)
@@ -734,6 +741,11 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
         raise ValueError(f"[study] {exc}") from None
     _run_count(math.prod(len(p) for p in parts), "[study] grid x list x random")
     seen: dict[str, str] = {key: "[study] set" for key in fixed}
+    for key in ("duration", "stop"):
+        if key in s and f"run.{key}" in seen:
+            raise ValueError(f"[study] 'run.{key}' is given both in [study] set and as [study] {key}; give it in one place")
+        if key in s:
+            seen[f"run.{key}"] = f"[study] {key}"
     for where, part in zip([n for n in ("grid", "list", "random") if n in s], parts):
         for key in sorted({k for row in part for k in row}):
             if key in seen:

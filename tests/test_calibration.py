@@ -28,7 +28,6 @@ def synthetic(monkeypatch: pytest.MonkeyPatch) -> None:
         return {"id": spec.id, "status": "ok", "beta": dict(spec.overrides)["damping.beta"]}
 
     monkeypatch.setattr(cal, "execute", lambda specs, *a, **k: [row(s) for s in specs])
-    monkeypatch.setattr(cal, "batch_row", row)  # the optimiser's single steps
     monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: _surface(r["beta"]))
 
 
@@ -65,6 +64,13 @@ def test_an_unusable_reference_file_is_refused_with_what_it_needs(tmp_path, text
     p.write_text(text)
     with pytest.raises(ValueError, match=r"reference .*ref\.csv.*need rows of time \[s\] and value"):
         cal.load_reference(p)
-    p.write_text("time,rotation\n0.0,0.1\n0.1,0.2\n")
-    ref = cal.load_reference(p)
-    assert list(ref.time) == [0.0, 0.1] and list(ref.value) == [0.1, 0.2]
+    for good in ("time,rotation\n0.0,0.1\n0.1,0.2\n", "   0.000   0.100\n   0.100  -0.200\n",  # np.savetxt's fmt='%8.3f'
+                 "t;x\n0.0; 0.1\n0.1;\t-0.2 # note\n"):
+        p.write_text(good)
+        ref = cal.load_reference(p)
+        assert list(ref.time) == [0.0, 0.1] and list(np.abs(ref.value)) == [0.1, 0.2]
+    p.write_text("0.0\n0.1\n0.2\n")
+    with pytest.raises(ValueError, match=r"found 1 column"):
+        cal.load_reference(p)
+    with pytest.raises(ValueError, match="is a folder"):
+        cal.load_reference(tmp_path)

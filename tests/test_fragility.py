@@ -102,6 +102,8 @@ def test_separated_outcomes_are_flagged_as_not_identifiable(tmp_path):
     assert bool(fits["separated"].iloc[0]) and fits["beta"].iloc[0] < 0.05
     report = write_report(table, fits, tmp_path).read_text()
     assert "(separated: not identifiable)" in report
+    tied = table.assign(pga_g=[0.1, 0.2, 0.3, 0.3, 0.5, 0.6])  # a failure and a survival at 0.3: still separated
+    assert bool(fit_all(tied)["separated"].iloc[0])
     mixed = table.assign(failed=[False, False, True, False, True, True])  # overlapping outcomes: a dispersion
     fits = fit_all(mixed)
     assert not bool(fits["separated"].iloc[0]) and fits["beta"].iloc[0] > 0.1
@@ -116,6 +118,10 @@ def test_runs_ending_before_their_record_s_strong_motion_are_noted(tmp_path):
     assert len(notes) == 1 and "Arias intensity" in notes[0] and "its PGA" not in notes[0]
     assert _cut_short(ida_specs("free-rocking", recs, [0.5], fixed=FIXED, duration=2.0)) == []
     assert len(_cut_short(ida_specs("free-rocking", recs, [0.5], fixed=FIXED, duration=0.2))) == 1  # before the PGA too
+    # a window of the record's second half runs from t = 0: its strong motion has arrived by 0.48 s
+    windowed = {**FIXED, "loading.window": [0.5, 1.0]}
+    assert _cut_short(ida_specs("free-rocking", recs, [0.5], fixed=windowed, duration=0.6)) == []
+    assert len(_cut_short(ida_specs("free-rocking", recs, [0.5], fixed=windowed, duration=0.3))) == 1
 
 
 def _unreadable(tmp_path) -> str:

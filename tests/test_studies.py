@@ -197,13 +197,22 @@ def test_study_file_and_cli(tmp_path):
 @pytest.mark.parametrize("tables,where", [
     ('set = { "damping.alpha" = 3.0 }\n[study.grid]\n"damping.alpha" = [2.0, 4.0]', "[study] set"),
     ('[study.list]\nrows = [{ "damping.alpha" = 2.0 }]\n[study.random]\n"damping.alpha" = [1.0, 3.0]', "[study.list]"),
+    ('stop = "rest"\n[study.grid]\n"damping.alpha" = [2.0]\n"run.stop" = ["off"]', "[study] stop"),
 ])
 def test_a_key_given_in_two_places_of_a_study_is_refused(tmp_path, tables, where):
     # set and grid naming the same key: the grid used to win silently
     f = tmp_path / "s.toml"
     f.write_text('[study]\nbase = "free-rocking"\nduration = 0.5\n' + tables + "\n")
-    with pytest.raises(ValueError, match=rf"'damping.alpha' is given both in {re.escape(where)} and in"):
+    with pytest.raises(ValueError, match=rf"'(damping.alpha|run.stop)' is given both in {re.escape(where)} and in"):
         load_study(f)
+
+
+def test_a_spec_refuses_an_override_of_what_the_study_sets_itself(base):
+    # an IDA's --set loading.pga_g=0.5 ran every level at 0.5 g while the table said 0.2 and 1.5
+    for overrides, kwargs in (({"loading.pga_g": 0.5}, {"pga_g": 0.2}), ({"loading.scale": 2.0}, {"pga_g": 0.2}),
+                              ({"run.duration": 3.0}, {"duration": 5.0}), ({"loading.record": "x"}, {"record": "nahanni"})):
+        with pytest.raises(ValueError, match=f"{re.escape(next(iter(overrides)))} is set by an override and by the study's own"):
+            RunSpec.make(base, overrides, **kwargs)
 
 
 def test_calibration_recovers_beta_and_alpha(base):
