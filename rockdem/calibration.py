@@ -80,14 +80,15 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         else:
             x = np.asarray(ds.monitor_displacement.values[:, 0, 0], dtype=float)
         return Reference(t, x, quantity)
-    need = f"need rows of time [s] and value (column {column}, zero-based), separated by commas, semicolons, spaces or tabs"
+    need = (f"need rows of time [s] and value (column {column}, zero-based), separated by commas or spaces, or by "
+            "semicolons or tabs (then with decimal points or commas)")
     try:
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise ValueError(f"reference {p}: not a text file; {need}") from None
     rows, widths = [], set()
     for line in text.splitlines():
-        fields = [f for f in re.split(r"[,;\s]+", line.split("#", 1)[0].strip()) if f]
+        fields = _fields(line.split("#", 1)[0].strip())
         try:
             values = [float(f) for f in fields]
         except ValueError:
@@ -100,6 +101,16 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
     if len(rows) < 2:
         raise ValueError(f"reference {p}: {len(rows)} numeric row(s); {need}, at least two rows")
     return Reference(np.array([r[0] for r in rows]), np.array([r[column] for r in rows]), quantity)
+
+
+def _fields(line: str) -> list[str]:
+    """The fields of a reference file's line: split at semicolons or tabs where it has them (a
+    comma in a field is then a decimal comma, as spreadsheets in many locales write: "0,1;0,25"),
+    else at commas and spaces ("0.1, 0.25", "   0.100   0.250")."""
+    for sep in (";", "\t"):
+        if sep in line:
+            return [f.strip().replace(",", ".") for f in line.split(sep) if f.strip()]
+    return [f for f in re.split(r"[,\s]+", line) if f]
 
 
 def reference_from_row(row: Mapping[str, Any], quantity: str = "rotation") -> Reference:

@@ -65,7 +65,7 @@ def test_an_unusable_reference_file_is_refused_with_what_it_needs(tmp_path, text
     with pytest.raises(ValueError, match=r"reference .*ref\.csv.*need rows of time \[s\] and value"):
         cal.load_reference(p)
     for good in ("time,rotation\n0.0,0.1\n0.1,0.2\n", "   0.000   0.100\n   0.100  -0.200\n",  # np.savetxt's fmt='%8.3f'
-                 "t;x\n0.0; 0.1\n0.1;\t-0.2 # note\n"):
+                 "t;x\n0.0; 0.1\n0.1; -0.2 # note\n", "t;x\n0,0;0,1\n0,1;-0,2\n", "0,0\t0,1\n0,1\t-0,2\n"):
         p.write_text(good)
         ref = cal.load_reference(p)
         assert list(ref.time) == [0.0, 0.1] and list(np.abs(ref.value)) == [0.1, 0.2]
