@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
-import re
 import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -86,31 +86,40 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise ValueError(f"reference {p}: not a text file; {need}") from None
+    lines = [line.split("#", 1)[0].strip() for line in text.splitlines()]
+    split = _splitter([line for line in lines if line])
     rows, widths = [], set()
-    for line in text.splitlines():
-        fields = _fields(line.split("#", 1)[0].strip())
+    for line in lines:
         try:
-            values = [float(f) for f in fields]
+            values = [float(f) for f in split(line)]
         except ValueError:
-            continue  # a header or a note
-        if values:
+            continue  # a header, a note, or a row with an empty field
+        if values and all(math.isfinite(v) for v in values):
             widths.add(len(values))
             rows.append(values)
     if rows and min(widths) <= column:
         raise ValueError(f"reference {p}: {need}; found {min(widths)} column(s)")
     if len(rows) < 2:
-        raise ValueError(f"reference {p}: {len(rows)} numeric row(s); {need}, at least two rows")
-    return Reference(np.array([r[0] for r in rows]), np.array([r[column] for r in rows]), quantity)
+        raise ValueError(f"reference {p}: {len(rows)} numeric row(s) of finite values; {need}, at least two rows")
+    t = np.array([r[0] for r in rows])
+    if np.any(np.diff(t) <= 0.0):
+        k = int(np.flatnonzero(np.diff(t) <= 0.0)[0])
+        raise ValueError(f"reference {p}: its times must increase, but {t[k + 1]:g} s follows {t[k]:g} s (numeric row {k + 2})")
+    return Reference(t, np.array([r[column] for r in rows]), quantity)
 
 
-def _fields(line: str) -> list[str]:
-    """The fields of a reference file's line: split at semicolons or tabs where it has them (a
-    comma in a field is then a decimal comma, as spreadsheets in many locales write: "0,1;0,25"),
-    else at commas and spaces ("0.1, 0.25", "   0.100   0.250")."""
-    for sep in (";", "\t"):
-        if sep in line:
-            return [f.strip().replace(",", ".") for f in line.split(sep) if f.strip()]
-    return [f for f in re.split(r"[,\s]+", line) if f]
+def _splitter(lines: Sequence[str]) -> Callable[[str], list[str]]:
+    """How a reference file's lines split into fields, chosen for the whole file: at semicolons
+    where it has them, or at tabs in a file without decimal points, with decimal commas
+    ("0,1;0,25", as spreadsheets in many locales write); else at commas ("0.1, 0.25"; an empty
+    field leaves its row out); else at spaces ("   0.100   0.250")."""
+    text = "\n".join(lines)
+    if ";" in text or ("\t" in text and "," in text and "." not in text):
+        sep = ";" if ";" in text else "\t"
+        return lambda line: [f.strip().replace(",", ".") for f in line.split(sep)] if line else []
+    if "," in text:
+        return lambda line: [f.strip() for f in line.split(",")] if line else []
+    return lambda line: line.split()
 
 
 def reference_from_row(row: Mapping[str, Any], quantity: str = "rotation") -> Reference:
@@ -227,7 +236,8 @@ def calibrate(
     if stop not in ("rest", "off"):
         raise ValueError(f"calibrate: stop must be 'rest' or 'off', got {stop!r} (a run stopped as collapsed has no history to compare)")
     fixed = with_stop(fixed, stop)
-    dur = float(duration) if duration is not None else float(reference.time[-1])
+    # the duration: given, else a fixed run.duration, else the reference's last time
+    dur = float(duration) if duration is not None else None if "run.duration" in fixed else float(reference.time[-1])
     evals: list[dict[str, Any]] = []
     cache: dict[str, float] = {}
 

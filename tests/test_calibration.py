@@ -69,8 +69,18 @@ def test_an_unusable_reference_file_is_refused_with_what_it_needs(tmp_path, text
         p.write_text(good)
         ref = cal.load_reference(p)
         assert list(ref.time) == [0.0, 0.1] and list(np.abs(ref.value)) == [0.1, 0.2]
+    for partial in ("t,a\n0.0,0.1\n0.05,,9\n0.1,-0.2\n", "0.0 0.1\n0.05 nan\n0.1 -0.2\n"):
+        p.write_text(partial)  # a row with an empty field or a NaN is left out, not shifted or kept
+        ref = cal.load_reference(p)
+        assert list(ref.time) == [0.0, 0.1] and list(ref.value) == [0.1, -0.2]
     p.write_text("0.0\n0.1\n0.2\n")
     with pytest.raises(ValueError, match=r"found 1 column"):
+        cal.load_reference(p)
+    p.write_text("0.0,0.1\n1.0,0.2\n0.5,0.3\n")
+    with pytest.raises(ValueError, match=r"times must increase, but 0.5 s follows 1 s"):
+        cal.load_reference(p)
+    p.write_text("0,0 0,1\n0,1 0,2\n")  # decimal commas between spaces: ambiguous, refused rather than misread
+    with pytest.raises(ValueError, match=r"0 numeric row"):
         cal.load_reference(p)
     with pytest.raises(ValueError, match="is a folder"):
         cal.load_reference(tmp_path)
