@@ -382,9 +382,8 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
                             log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
                             workers=args.workers, scheduler=args.scheduler, stop=args.stop, store=store)
     except KeyboardInterrupt:
-        kept = ("give --out to keep finished runs" if store is None else f"the finished runs are kept in {store.path} (rerun to "
-                "resume)" if store.path.exists() else "no run had finished (nothing kept)")
-        print(f"rockdem calibrate: stopped; {kept}", file=sys.stderr)
+        print(f"rockdem calibrate: stopped; {store.kept() if store is not None else 'give --out to keep finished runs'}",
+              file=sys.stderr)
         raise
     print(res.report())
     if out is not None:

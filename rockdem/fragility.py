@@ -227,9 +227,10 @@ def fit_all(table: pd.DataFrame) -> pd.DataFrame:
 
 def separated(im: Sequence[float], failed_: Sequence[bool]) -> bool:
     """Whether the outcomes are separated by the intensity: every failure at or above every
-    survival (records sharing their levels tie at the boundary: quasi-complete separation). The likelihood then grows as the dispersion goes to 0, so the fitted beta only
-    says how far apart the levels were, not the record-to-record dispersion: more records, or
-    levels between the last survival and the first failure, are needed."""
+    survival (records sharing their levels tie at the boundary: quasi-complete separation). The
+    likelihood then grows as the dispersion goes to 0, so the fitted beta only says how far apart
+    the levels were, not the record-to-record dispersion: more records, or levels between the last
+    survival and the first failure, are needed."""
     x = np.asarray(im, dtype=float)
     z = np.asarray(failed_, dtype=bool)
     return bool(z.any() and (~z).any() and x[~z].max() <= x[z].min())  # ties at one level too (quasi-complete)
@@ -545,7 +546,7 @@ def plot_spectra(specs: Sequence[RunSpec], path: str | os.PathLike[str], *, peri
     return p
 
 
-SEPARATED_NOTE = ("Separated: every run that failed had a higher intensity than every run that survived, so the "
+SEPARATED_NOTE = ("Separated: every run that failed had an intensity at or above every run that survived, so the "
                   "likelihood grows as the dispersion goes to 0 and the fitted beta says only how far apart the "
                   "levels were. Add records, or levels between the last survival and the first failure.")
 
@@ -597,9 +598,7 @@ def _fragility_cli(args: argparse.Namespace) -> int:
                                executor=args.executor or "process", workers=args.workers,
                                scheduler=args.scheduler, progress=not args.no_progress)
     except KeyboardInterrupt:
-        path = Store(args.out).path
-        kept = f"the finished runs are kept in {path} (rerun to resume)" if path.exists() else "no run had finished (nothing kept)"
-        print(f"rockdem fragility: stopped; {kept}", file=sys.stderr)
+        print(f"rockdem fragility: stopped; {Store(args.out).kept()}", file=sys.stderr)
         raise
     print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}, report.md")
     if frag is None:

@@ -225,18 +225,15 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
     s, sc = _allocate(model)
     s, sc = detect_all(model, s, sc)
     depth = -float(sc.min_separation[0])
-    if check_overlap and depth > m.touch_tol:
-        a, b = (int(v) for v in sc.min_pair)
-        raise ValueError(
-            f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.4g} m at the "
-            f"start (tolerance {m.touch_tol:.3g} m); move them apart so that they at most touch"
-        )
     if check_overlap and depth > START_OVERLAP_SHARE * m.touch_tol:
-        a, b = (int(v) for v in sc.min_pair)
+        a, b = (model.block_names[int(v)] for v in sc.min_pair)
+        if depth > m.touch_tol:
+            raise ValueError(f"blocks {a!r} and {b!r} overlap by {depth:.4g} m at the start (tolerance {m.touch_tol:.3g} m); "
+                             "move them apart so that they at most touch")
         warn_user(
-            f"blocks {model.block_names[a]!r} and {model.block_names[b]!r} overlap by {depth:.3g} m at the start: their "
-            "joint springs start compressed by that much and release its energy at the first steps (a 0.3 m cube "
-            "sunk 0.3 mm into the ground on kn = 5e9 Pa/m jumps 39 mm); move them apart so that they at most touch"
+            f"blocks {a!r} and {b!r} overlap by {depth:.3g} m at the start: their joint springs start compressed by that "
+            "much and release its energy at the first steps (a 0.3 m cube sunk 0.3 mm into the ground on kn = 5e9 Pa/m "
+            "jumps 39 mm); move them apart so that they at most touch"
         )
     bond_touching(m, s, sc)
     return s, sc

@@ -290,6 +290,10 @@ class Store:
             p = p / "runs.jsonl"
         self.path = p  # its folder is made at the first row: a study refused before any run writes nothing
 
+    def kept(self) -> str:
+        """What an interrupted study kept, for its stop message."""
+        return f"the finished runs are kept in {self.path} (rerun to resume)" if self.path.exists() else "no run had finished (nothing kept)"
+
     def rows(self) -> list[dict[str, Any]]:
         """All stored rows, one per id (in first-finished order)."""
         if not self.path.exists():
@@ -821,9 +825,7 @@ def _sweep(args: argparse.Namespace) -> int:
             df = run_study(study, out, executor=args.executor, workers=args.workers, scheduler=args.scheduler,
                            progress=not args.no_progress)
     except KeyboardInterrupt:
-        path = Store(out).path
-        kept = f"the finished runs are kept in {path} (rerun to resume)" if path.exists() else "no run had finished (nothing kept)"
-        print(f"rockdem sweep: stopped; {kept}", file=sys.stderr)
+        print(f"rockdem sweep: stopped; {Store(out).kept()}", file=sys.stderr)
         raise
     n_err = int((df["status"] == "error").sum()) if "status" in df else 0
     n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0
