@@ -915,8 +915,10 @@ def _extent(
     """The model's extent: the bounding box of every block at the start, enlarged on each side by
     its largest dimension (at least 1 m); and the plan footprint (x, y) of the driven blocks at the
     start (empty when there are none). A free block whose centroid leaves the extent through its
-    bottom outside that footprint fell off the edge of the supports and falls on unhindered; one
-    leaving it otherwise has fallen through its support or flown away, and the run stops there."""
+    bottom outside that footprint, or through a side, has left the supports (fell off their edge or
+    was thrown clear) and falls on unhindered; one leaving it through its bottom inside the footprint
+    has fallen through its support, one leaving it through its top has flown away, and the run
+    stops there."""
     world = _world_vertices(vertex_local, vstart, pos, quat, range(len(pos)))
     lo, hi = world.min(axis=0), world.max(axis=0)
     margin = max(float(np.max(hi - lo)), 1.0)

@@ -369,7 +369,7 @@ def run_model(
             attrs["fell_off_blocks"] = ", ".join(model.block_names[b] for b in fell)
             attrs["fell_off_times"] = state.fell_off[fell].astype(float)
             warn_user(
-                f"block(s) fell off the edge of the model's supports and fall on unhindered: {listed}; "
+                f"block(s) fell off the edge of the model's supports (or were thrown clear of them) and fall on unhindered: {listed}; "
                 "a larger foundation (the specimen builders' foundation_extent) keeps them",
                 RuntimeWarning)
         end = decision.frame + 1 if decision is not None else frame  # the result ends at the decided frame
@@ -663,7 +663,7 @@ def _failure(model: Model, rec: Records, bad: int, status: int, block: int, step
         ke[~model.arrays.block_free] = -1.0
         blocks = [model.block_names[b] for b in np.argsort(-ke)[: min(3, int(model.arrays.block_free.sum()))]]
     if status == STATUS_LOST:
-        reason = "left the model's extent (fell through its support or flew away: check the joint stiffness and the foundation size)"
+        reason = "left the model's extent (fell through its support or flew away: check the joint stiffness)"
     else:
         reason = (
             f"created energy (kinetic + potential + elastic above the initial energy plus the work done) beyond "

@@ -383,6 +383,35 @@ def test_a_block_falling_off_the_edge_of_its_foundation_falls_on_and_the_run_com
     assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81
 
 
+def test_a_block_thrown_clear_of_a_small_foundation_falls_on_and_the_run_completes():
+    # A cube sliding off a 0.6 m foundation at 6 m/s flies clear of it and leaves the model's
+    # extent (1 m beyond the blocks) through its side, not its bottom, while falling. It has left
+    # the supports, as one falling over their edge: the run goes on to its end (before 2026-11-28
+    # it stopped as "lost", a divergence), names it, and the cube is in free flight after it left.
+    from rockdem.simulation import simulate
+    from rockdem.specimens import add_foundation
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1e9 / 0.3, friction_angle=30)
+    add_foundation(b, 0.6)
+    b.add_box(0.3, 0.3, 0.3, base_center=(0, 0, 0), density=2000, name="cube", velocity=(6.0, 0, 0))
+    m = b.finalize(damping=Damping(beta=1e-4))
+    with pytest.warns(RuntimeWarning, match="fell off the edge"):
+        ds = simulate(m, 0.6, progress=False)
+    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(0.6, abs=1e-3)
+    assert ds.attrs["fell_off_blocks"] == "cube"
+    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+    x, z = ds.block_position.sel(block_id=1).values[:, 0], ds.block_position.sel(block_id=1).values[:, 2]
+    i_off = int(np.searchsorted(ds.time.values, t_off))
+    assert x[i_off] > m.arrays.extent_high[0] and z[i_off] > m.arrays.extent_low[2]  # it left through the side
+    late = ds.time.values > t_off
+    v = ds.block_velocity.sel(block_id=1).values[late]
+    assert np.allclose(np.gradient(v[:, 2], ds.time.values[late])[2:-2], -9.81, rtol=1e-3)  # free fall
+    assert np.allclose(v[:, 0], v[0, 0], rtol=1e-9) and 4.0 < v[0, 0] < 6.0  # flying on at the speed it left with
+    mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
+    assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81  # no energy created
+
+
 def test_alpha_that_overdamps_an_assembly_is_warned_about():
     # The discretised 0.19 x 2.0 m wall rocks as one body (2 p = 5.4 1/s); its bricks alone
     # would allow 16 1/s. alpha = 10 over-damps the wall's rocking: warned, naming the body.

@@ -782,6 +782,14 @@ def _blend(m: ModelArrays, s: State, sc: Scratch, i: int, fa: int, fb: int, a: i
 
 
 @njit(cache=True, _nrt=False, inline="always")
+def _slipped(ks_area: float, us0: float, us1: float, us2: float, cap: float) -> bool:
+    """Whether a shear spring of stiffness ``ks_area`` [N/m] with elastic extension us [m], left by
+    the last step, was slipping there: its force is at that step's Coulomb limit ``cap`` [N] (the
+    slip step scales the extension to it; a sticking spring stays below it)."""
+    return ks_area * math.sqrt(us0 * us0 + us1 * us1 + us2 * us2) >= (1.0 - 1e-9) * cap
+
+
+@njit(cache=True, _nrt=False, inline="always")
 def _released_dashpot(
     fd: np.ndarray, vd: np.ndarray, c: float, kn: float, ks: float, v0: float, v1: float, v2: float,
     vn: float, n0: float, n1: float, n2: float,
@@ -789,7 +797,11 @@ def _released_dashpot(
     """Force [N] of a dashpot at its first step out of contact (implicit dashpots):
     -c (kn v_n n + ks v_s), c [s m^2 or s] beta x its share of the step (x the area for a
     sub-contact), at the relative velocity v [m/s] (normal part vn along n); stored with that
-    velocity in ``fd``, ``vd`` (3,) for the work of :func:`rockdem.kernels.implicit.finalize`."""
+    velocity in ``fd``, ``vd`` (3,) for the work of :func:`rockdem.kernels.implicit.finalize`.
+    ``ks`` is 0 for a contact that slipped at its last step in contact, which had no shear dashpot
+    (:func:`_slipped`): a negative share of one it never had pushed a sliding contact along its
+    sliding (a cube landing at 6 m/s on a foundation gained 15 J of its 972 J, booked as negative
+    damping, before 2026-11-28)."""
     vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
     d0 = -c * (kn * vn * n0 + ks * vs0)
     d1 = -c * (kn * vn * n1 + ks * vs1)
@@ -840,7 +852,12 @@ def _release_pass(m: ModelArrays, s: State, sc: Scratch, nrel: int, dt: float) -
             # Implicit dashpots: the dashpot acted until the opening; its share of this velocity step
             # (negative: the last step applied it past the opening), at the last half step's velocity.
             c = m.mat_beta[go, gt] * dashpot_release_share(un, vn, dt) * prev_area
-            d0, d1, d2 = _released_dashpot(sc.dashpot_force[k], sc.dashpot_velocity[k], c, kn, ks, v0, v1, v2, vn, n0, n1, n2)
+            # the last step's Coulomb limit, as _law_range computed it (a stiffened corner's on its cell's area)
+            cap = coulomb_limit(m.mat_res_cohesion[go, gt], m.mat_res_tan_friction[go, gt], prev_area / max(s.slot_stiffening[p, j], 1.0),
+                                kn * prev_area * un_prev)
+            slid = _slipped(ks * prev_area, s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2], cap)
+            d0, d1, d2 = _released_dashpot(sc.dashpot_force[k], sc.dashpot_velocity[k], c, kn, 0.0 if slid else ks,
+                                           v0, v1, v2, vn, n0, n1, n2)
             c0 += d0
             c1 += d1
             c2 += d2
@@ -892,7 +909,8 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
             c0, c1, c2, e = release_shear(us0, us1, us2, ksa, m.mat_res_tan_friction[ga, gb] * kna, un_prev, vn, vs0, vs1, vs2, dt)
             if s.dashpots[0] == DASHPOTS_IMPLICIT and vn > 0.0 and m.mat_beta[ga, gb] > 0.0:  # as in _release_pass
                 c = m.mat_beta[ga, gb] * dashpot_release_share(un, vn, dt)
-                d0, d1, d2 = _released_dashpot(sc.pair_dashpot_force[i], sc.pair_dashpot_velocity[i], c, kna, ksa,
+                slid = _slipped(ksa, us0, us1, us2, coulomb_limit(m.mat_res_cohesion[ga, gb], m.mat_res_tan_friction[ga, gb], area, kna * un_prev))
+                d0, d1, d2 = _released_dashpot(sc.pair_dashpot_force[i], sc.pair_dashpot_velocity[i], c, kna, 0.0 if slid else ksa,
                                                v0, v1, v2, vn, n0, n1, n2)
                 c0 += d0
                 c1 += d1

@@ -43,7 +43,7 @@ DASHPOTS_EXPLICIT = 1  # on the last half step's velocities, Belytschko-reduced 
 STATUS_DONE = 0
 STATUS_GROW = 1  # the pair or candidate buffers are full: enlarge them and continue
 STATUS_DIVERGED = 2  # energy balance broken or a non-finite state
-STATUS_LOST = 3  # a free block left the model's extent (fell through its support or flew away)
+STATUS_LOST = 3  # a free block fell through its support or flew away (left the model's extent through its bottom or top)
 
 # Energy accumulator slots (State.energy) and recorded energy columns.
 E_KINETIC = 0

@@ -419,12 +419,13 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     was created: the mechanical energy (kinetic + potential + elastic) exceeds its initial value
     plus the work done on the model by more than DIVERGENCE_ERROR of the energy scale reached so far
     (kinetic + elastic + |potential change| + dissipated + |work|, at least the work of lifting the
-    free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent (fell
-    through its support or flew away; the extent and the footprint below move with the driven
-    blocks); else STATUS_DONE. ``sc.lost_block`` names the block (-1 for
-    an energy divergence). A block leaving the extent through its bottom outside the plan footprint
-    of the driven blocks fell off the edge of the supports: its time is noted in ``s.fell_off``
-    and it falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
+    free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent through
+    its bottom inside the plan footprint of the driven blocks (it fell through its support) or
+    through its top (it flew away); else STATUS_DONE (the extent and the footprint move with the
+    driven blocks). ``sc.lost_block`` names the block (-1 for an energy divergence). A block leaving
+    the extent through its bottom outside the footprint, or through a side (thrown clear of the
+    supports, it is falling), has left the supports: its time is noted in ``s.fell_off`` and it
+    falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
     recorded balance error but is not a divergence.)"""
     e = rec.energy[frame]
     e0 = rec.energy[0]
@@ -453,13 +454,13 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
             sc.lost_block[0] = b
             return STATUS_DIVERGED
-        low = z < m.extent_low[2] + lz
-        outside = (low or z > m.extent_high[2] + hz or x < m.extent_low[0] + lx or x > m.extent_high[0] + hx
+        high = z > m.extent_high[2] + hz
+        outside = (high or z < m.extent_low[2] + lz or x < m.extent_low[0] + lx or x > m.extent_high[0] + hx
                    or y < m.extent_low[1] + ly or y > m.extent_high[1] + hy)
         if outside:
             on_support = (m.support_low[0] + lx <= x <= m.support_high[0] + hx
                           and m.support_low[1] + ly <= y <= m.support_high[1] + hy)
-            if low and not on_support:
+            if not high and not on_support:  # below the top, beside the supports: it left them
                 s.fell_off[b] = rec.time[frame]
                 continue
             sc.lost_block[0] = b
