@@ -46,6 +46,8 @@ __all__ = [
     "result_eta",
     "eta_of",
     "FALL_FRACTION",
+    "fallen",
+    "block_thickness_of",
     "TIPPED_ANGLE",
     "fallen_blocks",
     "is_free_rocking",
@@ -587,44 +589,63 @@ FALL_FRACTION = 0.5
 
 
 def fallen_blocks(ds: Any, frame: int = -1) -> NDArray[np.int64]:
-    """Ids of the free blocks of a rockdem result that have fallen by ``frame`` (default the last):
-    their centroid is lower than at the first frame, relative to the ground's own vertical motion,
-    by more than :data:`FALL_FRACTION` of the block's smallest dimension.
-
-    The drop is measured from the reference (untilted) pose, ``block_position_reference``, where
-    present (results before 2026-11-27: from the first frame). Or, with ``block_rotation`` (time,
-    block, xyz; from the reference pose), whose reference vertical axis is tilted by more than
-    :data:`TIPPED_ANGLE`, or by more than its own ``block_eta`` for a squat block, at ``frame``: it
-    lies on another face, or leans (a block toppled onto its side drops only (h - w) / 2, less than
-    the fraction for h < 2 w).
+    """Ids of the free blocks of a rockdem result that have fallen by ``frame`` (default the last),
+    by :func:`fallen`: their centroid is lower than in the reference (untilted) pose,
+    ``block_position_reference`` (results before 2026-11-27: the first frame), relative to the
+    ground's own vertical motion, by more than :data:`FALL_FRACTION` of the block's smallest
+    dimension; or, with ``block_rotation`` (time, block, xyz; from the reference pose), they are
+    tipped past :data:`TIPPED_ANGLE` (a squat block: past its own ``block_eta``).
 
     Uses ``block_position (time, block, xyz)``, ``block_free``, ``vertex_local`` and
     ``block_vertex_start`` (the smallest extent of each block in its body frame), the ``gravity``
     attribute (default -z) and ``ground_displacement (time, xyz)`` when present.
     """
     free = np.flatnonzero(np.asarray(ds["block_free"].values, dtype=bool))
-    g = np.asarray(ds.attrs.get("gravity", (0.0, 0.0, -9.81)), dtype=float).reshape(3)
-    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    start = np.asarray(ds["block_vertex_start"].values, dtype=np.int64)
-    v = np.asarray(ds["vertex_local"].values, dtype=float)
-    thickness = np.array([float(np.ptp(v[start[b]:start[b + 1]], axis=0).min()) for b in free])
     pos = np.asarray(ds["block_position"].values, dtype=float)
-    # from the reference pose: a tilted release starts raised, and an assembly back upright has not fallen
     ref = np.asarray(ds["block_position_reference"].values, dtype=float)[free] if "block_position_reference" in ds else pos[0, free]
-    drop = (ref - pos[frame, free]) @ up
-    if "ground_displacement" in ds:
-        drop = drop + float(np.asarray(ds["ground_displacement"].values[frame], dtype=float) @ up)
-    fallen = drop > FALL_FRACTION * thickness
-    if "block_rotation" in ds:
+    ground = np.asarray(ds["ground_displacement"].values[frame], dtype=float) if "ground_displacement" in ds else np.zeros(3)
+    rotation = np.asarray(ds["block_rotation"].values[frame, free], dtype=float) if "block_rotation" in ds else None
+    eta = np.asarray(ds["block_eta"].values, dtype=float)[free] if "block_eta" in ds else None
+    mask = fallen(ref, pos[frame, free], block_thickness_of(ds["vertex_local"].values, ds["block_vertex_start"].values, free),
+                  ground=ground, rotation=rotation, eta=eta, gravity=ds.attrs.get("gravity", (0.0, 0.0, -9.81)))
+    return free[mask]
+
+
+def block_thickness_of(vertex_local: ArrayLike, vertex_start: ArrayLike, blocks: ArrayLike) -> NDArray[np.float64]:
+    """(n,) smallest extent [m] of each of ``blocks`` in its body frame, from ``vertex_local``
+    (nv, 3) [m] and ``vertex_start`` (nb+1,)."""
+    v = np.asarray(vertex_local, dtype=float)
+    start = np.asarray(vertex_start, dtype=np.int64)
+    return np.array([float(np.ptp(v[start[b]:start[b + 1]], axis=0).min()) for b in np.asarray(blocks, dtype=np.int64)])
+
+
+def fallen(
+    position_reference: ArrayLike, position: ArrayLike, thickness: ArrayLike, *, ground: ArrayLike = (0.0, 0.0, 0.0),
+    rotation: ArrayLike | None = None, eta: ArrayLike | None = None, gravity: ArrayLike = (0.0, 0.0, -9.81),
+) -> NDArray[np.bool_]:
+    """(n,) whether each of n blocks has fallen: its centroid ``position`` (n, 3) [m] is lower than
+    ``position_reference`` (n, 3) [m], relative to the ``ground`` displacement (3,) [m], by more than
+    :data:`FALL_FRACTION` of its ``thickness`` (n,) [m] (smallest dimension); or, given its
+    ``rotation`` (n, 3) [rad] from the reference pose (a rotation vector), the axis that was
+    vertical there is tilted past :data:`TIPPED_ANGLE`, or past the block's ``eta`` (n,) [rad] where
+    larger (a squat block may stand tilted up to it): it lies on another face, or leans (a block
+    toppled onto its side drops only (h - w) / 2, less than the fraction for h < 2 w). "Vertical"
+    is against ``gravity`` (3,) [m/s^2] (+z without gravity)."""
+    g = np.asarray(gravity, dtype=float).reshape(3)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    drop = (np.asarray(position_reference, dtype=float) - np.asarray(position, dtype=float)) @ up
+    drop = drop + np.asarray(ground, dtype=float) @ up
+    out = drop > FALL_FRACTION * np.asarray(thickness, dtype=float)
+    if rotation is not None:
         # The tilt of the axis that was vertical in the block's reference (untilted) pose: for a
         # rotation by theta about unit k, up . R up = cos theta + (k . up)^2 (1 - cos theta).
-        w = np.asarray(ds["block_rotation"].values[frame, free], dtype=float)  # (nf, 3) [rad]
+        w = np.asarray(rotation, dtype=float).reshape(-1, 3)
         theta = np.linalg.norm(w, axis=1)
         k_up = (w @ up) / np.where(theta > 0.0, theta, 1.0)
-        eta = np.asarray(ds["block_eta"].values, dtype=float)[free] if "block_eta" in ds else np.zeros(free.size)
-        limit = np.maximum(TIPPED_ANGLE, np.nan_to_num(eta))  # a squat block may stand tilted up to its eta
-        fallen |= np.cos(theta) + k_up**2 * (1.0 - np.cos(theta)) < np.cos(limit)
-    return free[fallen]
+        e = np.zeros(len(w)) if eta is None else np.nan_to_num(np.asarray(eta, dtype=float))
+        limit = np.maximum(TIPPED_ANGLE, e)
+        out |= np.cos(theta) + k_up**2 * (1.0 - np.cos(theta)) < np.cos(limit)
+    return out
 
 
 def is_pushover(ds: Any) -> bool:

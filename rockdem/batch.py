@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .analysis import eta_of, lowest_vertex_height, summarize
+from .analysis import block_thickness_of, eta_of, fallen, lowest_vertex_height, summarize
 from .case import Case, CaseTemplate, template_key
 from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION, E_POTENTIAL, ENERGY_NAMES
 from .results import block_eta, damping_attrs, energy_check, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
@@ -59,6 +59,9 @@ class Frames(NamedTuple):
         energy: (T, len(ENERGY_NAMES)) recorded energies [J], columns as ``ENERGY_NAMES``, the
             potential energy counted from the first frame (as the Dataset stores it).
         attrs: the result's attributes (steps, dt, runtime_s, diverged..., stop_reason..., the loading's).
+        position_reference: (nb, 3) centroids in the reference (untilted) pose [m].
+        rotation_end: (nb, 3) rotation vectors from the reference pose at the last frame [rad].
+        ground_end: (3,) displacement of the ground at the last frame [m].
     """
 
     time: np.ndarray
@@ -74,6 +77,9 @@ class Frames(NamedTuple):
     block_vertex_start: np.ndarray
     energy: np.ndarray
     attrs: Mapping[str, Any]
+    position_reference: np.ndarray
+    rotation_end: np.ndarray
+    ground_end: np.ndarray
 
 
 def frames_from_dataset(ds: Any) -> Frames:
@@ -85,6 +91,10 @@ def frames_from_dataset(ds: Any) -> Frames:
         ds.block_eta.values if "block_eta" in ds else np.full(ds.sizes["block"], np.nan),
         ds.vertex_local.values, ds.block_vertex_start.values,
         np.stack([np.asarray(ds[n].values, dtype=float) for n in ENERGY_NAMES], axis=1), dict(ds.attrs),
+        # results before 2026-11-27 lack the reference pose: the first frame stands for it
+        ds.block_position_reference.values if "block_position_reference" in ds else ds.block_position.values[0],
+        ds.block_rotation.values[-1] if "block_rotation" in ds else np.zeros((ds.sizes["block"], 3)),
+        ds.ground_displacement.values[-1] if "ground_displacement" in ds else np.zeros(3),
     )
 
 
@@ -96,14 +106,14 @@ def frames_from_run(case: Case, out: Any) -> Frames:
     u_ground = ground_displacement(model, rec.position)
     mon = monitor_displacements(model, rel_ref, rec.position, out.monitors) - u_ground[:, None]
     m = model.arrays
-    attrs = {**out.attrs, **damping_attrs(model), "point_count": model.point_count, **case.attrs}
+    attrs = {**out.attrs, **damping_attrs(model), "point_count": model.point_count, "gravity": m.gravity.tolist(), **case.attrs}
     energy = np.array(rec.energy, dtype=float)
     if len(energy):
         energy[:, E_POTENTIAL] -= energy[0, E_POTENTIAL]  # as build_dataset stores it
     return Frames(
         rec.time, rocking_angles(model, rotvec), rec.position, rec.quaternion, mon, int(rec.counts[-1, COUNT_FAILED_SHEAR]),
         int(rec.counts[-1, COUNT_FAILED_TENSION]), np.asarray(m.block_free, dtype=bool), block_eta(model),
-        m.vertex_local, m.block_vertex_start, energy, attrs,
+        m.vertex_local, m.block_vertex_start, energy, attrs, model.position_ref, rotvec[-1], u_ground[-1],
     )
 
 
@@ -153,6 +163,9 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     eta = eta or s.get("eta_rad")  # a released assembly: the assembly's angle
     row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
     row["overturned"] = bool(s.get("overturned", False))
+    row["fallen_blocks"] = int(np.count_nonzero(fallen(
+        f.position_reference[free], f.position[-1, free], block_thickness_of(f.vertex_local, starts, free), ground=f.ground_end,
+        rotation=f.rotation_end[free], eta=f.block_eta[free], gravity=a.get("gravity", (0.0, 0.0, -9.81)))))
     row["residual_rad"] = float(s["residual_rad"])
     if f.monitor.shape[1]:
         u = np.asarray(f.monitor[:, 0, :], dtype=float)

@@ -143,9 +143,10 @@ COLLAPSE_REASONS = ("overturned", "fell")
 
 
 def failed(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
-    """Failure of each run: overturned, stopped because it collapsed (``stop_reason``), or peak
-    rotation > drift_limit x eta (a nullable boolean: <NA> for runs without an outcome, see
-    :func:`completed`)."""
+    """Failure of each run: overturned, stopped because it collapsed (``stop_reason``), a block
+    fallen at its end (``fallen_blocks`` > 0: partial collapse counts, as the "fell" stop does;
+    tables from before 2026-11-28 have no such column), or peak rotation > drift_limit x eta (a
+    nullable boolean: <NA> for runs without an outcome, see :func:`completed`)."""
     done = completed(table)
     f = pd.Series(pd.NA, index=table.index, dtype="boolean")
     if done.any():
@@ -153,6 +154,8 @@ def failed(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
         g = sub["overturned"].astype(bool)
         if "stop_reason" in sub:
             g = g | sub["stop_reason"].isin(COLLAPSE_REASONS)
+        if "fallen_blocks" in sub:
+            g = g | (pd.to_numeric(sub["fallen_blocks"], errors="coerce").fillna(0) > 0)
         if drift_limit is not None:
             g = g | (sub["max_rotation_over_eta"].astype(float) > drift_limit)
         f[done] = g.to_numpy()

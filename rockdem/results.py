@@ -338,9 +338,9 @@ def _base(model: Model, b: int) -> tuple[float, float, float] | None:
 
 def block_thickness(model: Model) -> np.ndarray:
     """(nb,) smallest extent of each block along its principal axes [m]."""
-    m = model.arrays
-    v, start = m.vertex_local, m.block_vertex_start
-    return np.array([float(np.ptp(v[start[b] : start[b + 1]], axis=0).min()) for b in range(model.block_count)])
+    from .analysis import block_thickness_of
+
+    return block_thickness_of(model.arrays.vertex_local, model.arrays.block_vertex_start, np.arange(model.block_count))
 
 
 def block_eta(model: Model) -> np.ndarray:

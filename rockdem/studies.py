@@ -240,7 +240,8 @@ def run_spec(spec: RunSpec) -> dict[str, Any]:
     summary then covers the sound part), with ``run.stop`` on (:mod:`rockdem.stopping`):
     ``stop_reason`` ("overturned", "fell", "rest", or None for a run that went to its end),
     ``stop_time_s`` and ``stop_block``; ``max_rotation_rad``, ``max_rotation_over_eta``,
-    ``overturned``, ``residual_rad``, ``residual_disp_m`` / ``max_disp_m`` (first monitor,
+    ``overturned``, ``fallen_blocks`` (free blocks fallen at the end: :func:`rockdem.analysis.fallen`),
+    ``residual_rad``, ``residual_disp_m`` / ``max_disp_m`` (first monitor,
     horizontal), ``e_a_mean``, ``bounce_max_m_s``, ``failed_shear_fraction``,
     ``failed_tension_fraction``, ``energy_created_J`` (the largest rise of the mechanical energy beyond
     the work done: energy the engine created), ``energy_error_J`` (energy-balance error at the end) and

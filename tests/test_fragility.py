@@ -202,3 +202,43 @@ def test_a_run_stopped_because_it_collapsed_is_a_failure():
                       "stop_reason": ["fell", "rest", None, None], "max_rotation_over_eta": [0.2, 0.2, 1.5, 0.7]})
     assert list(failed(t)) == [True, False, True, False]
     assert list(failed(t, drift_limit=0.5)) == [True, False, True, True]
+
+
+def test_a_run_with_a_fallen_block_is_a_failure_also_without_stopping():
+    """A slender block tilted past its eta on a squat one topples off it onto the ground; the squat
+    block (the one a row analyses: the first free block) stays upright, so it is not "overturned".
+    The run's row, with no stop rule, counts the fallen block (``fallen_blocks``, by
+    rockdem.analysis.fallen, as ``rockdem run``'s summary counts it) and fragility counts the run
+    as a failure, as the "fell" stop would have. Before 2026-11-28 it was a survival."""
+    from rockdem.analysis import fallen_blocks
+    from rockdem.batch import frames_from_dataset, summary_row
+    from rockdem.case import example_case
+    from rockdem.fragility import failed
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+    from rockdem.simulation import simulate
+    from rockdem.studies import RunSpec
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial.from_modulus(1e9, 0.5, friction_angle=35)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.6, 0.6, 0.3, density=2000, name="base")
+    b.add_box(0.15, 0.4, 0.9, base_center=(0.2, 0, 0.3), density=2000, name="top")
+    b.tilt("top", 1.3)  # past its slenderness: it topples towards +x, off the base
+    ds = simulate(b.finalize(damping=Damping(beta=5e-4)), 2.0, progress=False, record_interval=0.01)
+    assert ds.attrs.get("diverged", 0) == 0
+    assert list(ds.block_name.values[fallen_blocks(ds)]) == ["top"]
+    row = summary_row(RunSpec.make(example_case("free-rocking")), {}, frames_from_dataset(ds))
+    assert row["status"] == "ok" and not row["overturned"] and row["max_rotation_rad"] < 0.05  # the base stayed
+    assert row["fallen_blocks"] == 1
+    t = pd.DataFrame([row])
+    assert list(failed(t)) == [True]
+    assert list(failed(t.drop(columns="fallen_blocks"))) == [False]  # what the row said before
+
+
+def test_fallen_blocks_count_in_the_failure_of_table_rows():
+    from rockdem.fragility import failed
+
+    t = pd.DataFrame({"status": ["ok"] * 3, "overturned": [False, False, False], "stop_reason": [None, None, "rest"],
+                      "fallen_blocks": [0, 3, None], "max_rotation_over_eta": [0.2, 0.2, 0.2]})
+    assert list(failed(t)) == [False, True, False]
