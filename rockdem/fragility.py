@@ -53,6 +53,7 @@ __all__ = [
     "ida_counts",
     "collapse_capacities",
     "plot_ida",
+    "rotation_floor",
     "plot_fragility",
     "plot_fragility_all",
     "plot_spectra",
@@ -378,8 +379,18 @@ def _style(k: int) -> dict[str, Any]:
     return {"color": f"C{k % 10}", "marker": MARKERS[k % len(MARKERS)], "ls": LINESTYLES[(k // 10) % len(LINESTYLES)]}
 
 
-ROTATION_FLOOR = 1e-3
-"""Smallest peak rotation / eta shown on the IDA plot's log axis (smaller values are drawn there)."""
+ROTATION_FLOOR = 1e-6
+"""Smallest peak rotation / eta the IDA plot's log axis reaches down to (a block at rest, 0, is
+drawn there). The axis starts at the smallest survival's value, or at 1e-3 when all are larger."""
+
+
+def rotation_floor(values: pd.Series) -> float:
+    """Where the IDA plot's log axis of peak rotation / eta starts, for the survivals' ``values``:
+    the smallest positive one, at most 1e-3 and at least :data:`ROTATION_FLOOR` (so that levels
+    below 1e-3 stay apart; values below it, a block at rest, are drawn at it)."""
+    v = pd.to_numeric(values, errors="coerce").astype(float)
+    v = v[v > 0.0]
+    return max(min(1e-3, float(v.min()) if len(v) else 1e-3), ROTATION_FLOOR)
 
 
 def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: float | None = None,
@@ -396,11 +407,12 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
     y_all = table[im].astype(float)
     shown: set[str] = set()
     x_max = 1.0
+    floor = rotation_floor(table.loc[status.eq("ok") & fail.eq(False), "max_rotation_over_eta"])
     for k, rec in enumerate(recs):
         g = table[(table["record"].astype(str) == rec)]
         sty = _style(k)
         ok = g[status[g.index].eq("ok") & fail[g.index].eq(False)].sort_values(im)
-        x = np.clip(ok["max_rotation_over_eta"].astype(float), ROTATION_FLOOR, None)
+        x = np.clip(ok["max_rotation_over_eta"].astype(float), floor, None)
         x_max = max(x_max, float(x.max()) if len(x) else 1.0)
         ax.plot(x, ok[im], lw=1.2, ms=3.5, alpha=0.85, markevery=max(1, len(ok) // 40), label=Path(rec).stem, **sty)
         # the strip: one column per record
@@ -423,7 +435,7 @@ def plot_ida(table: pd.DataFrame, path: str | os.PathLike[str], *, drift_limit: 
         ax.axvline(drift_limit, color="r", lw=0.8, ls="--", label=f"drift limit {drift_limit:g} eta")
     ax.axvline(1.0, color="0.5", lw=0.6)
     ax.set_xscale("log")
-    ax.set_xlim(ROTATION_FLOOR * 0.8, 1.5 * x_max)
+    ax.set_xlim(floor * 0.8, 1.5 * x_max)
     ax.set_xlabel("peak rotation / eta [-] (survivals; dotted: each record's collapse capacity)")
     ax.set_ylabel(_im_label(table, im))
     ax.grid(True, which="both", alpha=0.25)

@@ -242,3 +242,14 @@ def test_fallen_blocks_count_in_the_failure_of_table_rows():
     t = pd.DataFrame({"status": ["ok"] * 3, "overturned": [False, False, False], "stop_reason": [None, None, "rest"],
                       "fallen_blocks": [0, 3, None], "max_rotation_over_eta": [0.2, 0.2, 0.2]})
     assert list(failed(t)) == [False, True, False]
+
+
+def test_the_ida_plot_keeps_small_rotations_apart():
+    """Survivals at 2e-4 and 6e-4 eta were both drawn at 1e-3 (the plot's fixed floor); the axis now
+    starts at the smallest, and a block at rest (0) is drawn there."""
+    from rockdem.fragility import ROTATION_FLOOR, rotation_floor
+
+    assert rotation_floor(pd.Series([6e-4, 2e-4, 0.3, 0.0])) == 2e-4
+    assert rotation_floor(pd.Series([0.01, 0.5])) == 1e-3
+    assert rotation_floor(pd.Series([0.0, np.nan])) == 1e-3
+    assert rotation_floor(pd.Series([1e-12, 0.2])) == ROTATION_FLOOR
