@@ -31,6 +31,7 @@ import contextlib
 import math
 import os
 import signal
+import sys
 import threading
 import time as _time
 from dataclasses import dataclass
@@ -681,14 +682,22 @@ def _failure(model: Model, rec: Records, bad: int, status: int, block: int, step
     }
 
 
+PROGRESS_LOG_INTERVAL = 30.0
+"""Seconds between progress updates when stderr is not a terminal (a log file, a batch job): the
+bar's 0.1 s updates wrote some 700 lines of carriage returns into the log of a 3 min run."""
+
+
 def _progress_bar(duration: float, start: float = 0.0) -> Any:
     from tqdm.auto import tqdm
 
+    # a terminal, or a notebook's widget (tqdm.auto picks it in Jupyter, where stderr is no tty)
+    live = bool(getattr(sys.stderr, "isatty", lambda: False)()) or "notebook" in tqdm.__module__
     return tqdm(
         total=duration,
         initial=start,
         unit="s",
         desc="rockdem",
+        mininterval=0.1 if live else PROGRESS_LOG_INTERVAL,
         bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.3f}/{total:.3f} s simulated [{elapsed}<{remaining}]",
     )
 

@@ -316,3 +316,27 @@ def test_a_sinking_block_is_found_when_it_sinks():
         assert f"DIVERGED at t = {t_bad:.4g} s: the result holds the frames up to it, the last ones already sinking" in lines
     ds.attrs.update(duration=0.1, diverged_reason="energy")
     assert f"DIVERGED at the end of the run (its last step reached t = {t_bad:.4g} s): the result holds the sound frames" in "\n".join(summary_lines(ds))
+
+
+def test_the_progress_bar_writes_seldom_into_a_log(monkeypatch):
+    """Into a log file or a batch job's output (stderr no terminal) the bar updates every
+    PROGRESS_LOG_INTERVAL s, not ten times a second; on a terminal it stays live."""
+    import io
+    import sys
+
+    from rockdem.simulation import PROGRESS_LOG_INTERVAL, _progress_bar
+
+    log = io.StringIO()
+    monkeypatch.setattr(sys, "stderr", log)
+    bar = _progress_bar(5.0)
+    assert bar.mininterval == PROGRESS_LOG_INTERVAL >= 10.0
+    bar.close()
+
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    bar = _progress_bar(5.0)
+    assert bar.mininterval <= 0.1
+    bar.close()
