@@ -268,7 +268,7 @@ def run_model(
     # (a contact snapshot or the end of the run may cut it short); see the module notes.
     target = run.check_target if stopper is not None else None
     if stopper is not None and frame > 0 and target is None:
-        decision = stopper.check(rec, frame)  # a continued run: the saved frames may decide it already
+        decision = stopper.check(rec, frame, state.fell_off)  # a continued run: the saved frames may decide it already
     kernel = 0.0
     bar = None
     interrupted = False
@@ -301,7 +301,7 @@ def run_model(
                 if stopper is not None:
                     # a new chunk starts here, unless the end of this run cut it short (kept for a continuation)
                     target = target if t_stop == t_end < target else None
-                    decision = stopper.check(rec, frame)
+                    decision = stopper.check(rec, frame, state.fell_off)
             if stopper is None:
                 chunk = min(chunk * 4.0, max(float(state.dt[0]), chunk * 0.25 / max(elapsed, 1e-6)), longest)
             saver.maybe(state, scratch, rec, frame, snaps, _time.perf_counter() - wall0, target)
@@ -320,7 +320,7 @@ def run_model(
     late: list[int] = []
     with _deferred_signals(finishing=True, late=late):
         if stopper is not None and decision is None and status == STATUS_DONE and sunk is None:
-            decision = stopper.check(rec, frame)  # frames not examined yet (a continuation with nothing to compute)
+            decision = stopper.check(rec, frame, state.fell_off)  # frames not examined yet (a continuation with nothing to compute)
         runtime = _time.perf_counter() - wall0 + run.runtime_before
         attrs: dict[str, Any] = {
             "dt": info.dt,

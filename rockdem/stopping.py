@@ -25,13 +25,16 @@ Criteria (``docs/studies.md`` lists them per specimen):
 * **fell** (several free blocks: walls, stacks, façades, released assemblies): a free block's
   centroid has dropped below its starting height, relative to the ground, by more than half the
   block's smallest dimension (a brick thrown off a wall, a toppled slender block: partial
-  collapse counts).
+  collapse counts). In every model, also with one free block: a free block left the supports
+  (fell off their edge or was thrown clear of them, ``State.fell_off``), at the frame the engine
+  noted it.
 * **rest** (every model): the input has ended (the ground acceleration is zero, the driven
   velocities constant, from ``t_in`` on) and, over the last :data:`REST_WINDOW` seconds of
   recorded frames after ``t_in``, every free block moved (relative to the ground) by less than
   :data:`REST_DISPLACEMENT` of its smallest dimension and turned by less than
   :data:`REST_ROTATION`, with speeds below :data:`REST_SPEED` sqrt(g d). The residual drift is
-  then known to that tolerance.
+  then known to that tolerance. Blocks that left the supports (they fall for ever) are left out,
+  as long as one block remains.
 
 Runs without a stop rule (``rockdem run``, the default) are unchanged.
 """
@@ -240,24 +243,42 @@ class Stopper:
                 "quat_ref": quats_to_matrices(self.model.quaternion_ref[b]), "axis": self.model.rocking_axis,
                 "q_ref": np.asarray(self.model.quaternion_ref[b], dtype=float), "eta_min": min(p.eta for p in pivots)}
 
-    def check(self, rec: Any, frame: int) -> Decision | None:
+    def check(self, rec: Any, frame: int, fell_off: np.ndarray | None = None) -> Decision | None:
         """The first decided frame among those recorded since the last check (frames
         ``checked..frame-1`` of ``rec``, a Records, from frame 1 on), or None. The decision does not depend on how
         the run was cut into chunks: each frame is judged on its own (collapse) or on the window
-        of frames before it (rest)."""
+        of frames before it (rest).
+
+        ``fell_off`` (nb,): the time [s] each block left the supports (``State.fell_off``, -1: it
+        did not; the engine notes it at a recorded frame's time). Such a block has fallen (the
+        collapse rule decides "fell" at that frame, for a single block too) and is left out of the
+        rest check from then on: it falls for ever, and the others may come to rest."""
         lo, self.checked = max(self.checked, 1), frame  # a result keeps at least two frames
         if frame <= lo:
             return None
+        off = np.full(len(self.thickness), -1.0) if fell_off is None else np.asarray(fell_off, dtype=float)
         found: list[Decision] = []
         if self.rule.collapse:
-            d = self._overturned(rec, lo, frame) if self.pivot is not None else self._fell(rec, lo, frame)
-            if d is not None:
-                found.append(d)
+            for d in (self._overturned(rec, lo, frame) if self.pivot is not None else self._fell(rec, lo, frame),
+                      self._left(rec, lo, frame, off)):
+                if d is not None:
+                    found.append(d)
         if self.rule.rest and float(rec.time[frame - 1]) - self.window >= self.t_input:
-            d = self._rest(rec, lo, frame)
+            d = self._rest(rec, lo, frame, off)
             if d is not None:
                 found.append(d)
         return min(found, key=lambda d: d.frame) if found else None
+
+    def _left(self, rec: Any, lo: int, hi: int, off: np.ndarray) -> Decision | None:
+        """The first frame in lo..hi-1 at which a free block left the supports (``off``: see :meth:`check`)."""
+        best: Decision | None = None
+        for b in self.free:
+            if off[b] < 0.0:
+                continue
+            k = lo + int(np.searchsorted(rec.time[lo:hi], off[b] - 1e-9 * max(1.0, off[b])))
+            if k < hi and (best is None or k < best.frame):
+                best = Decision("fell", float(rec.time[k]), self.model.block_names[int(b)], k)
+        return best
 
     def _overturned(self, rec: Any, lo: int, hi: int) -> Decision | None:
         p = self.pivot
@@ -302,9 +323,10 @@ class Stopper:
         k0 = lo + int(frames[0])
         return Decision("fell", float(rec.time[k0]), self.model.block_names[int(self.free[np.argmax(fallen[frames[0]])])], k0)
 
-    def _rest(self, rec: Any, lo: int, hi: int) -> Decision | None:
+    def _rest(self, rec: Any, lo: int, hi: int, off: np.ndarray) -> Decision | None:
         """First frame k in lo..hi-1 whose window (the frames of the last ``window`` seconds up
-        to k, all after the input's end) is at rest."""
+        to k, all after the input's end) is at rest: every free block still, except those that
+        left the supports by frame k (``off``: see :meth:`check`), and at least one is left."""
         length = self.window_frames
         if hi < length:
             return None
@@ -319,16 +341,21 @@ class Stopper:
             vel = vel - rec.velocity[start:hi][:, self.ground][:, None]
         d = self.thickness[f]
         v_tol = REST_SPEED * np.sqrt(self.g * d) if self.g > 0 else REST_SPEED * d
-        fast = ((np.linalg.norm(vel, axis=2) > v_tol) | (np.linalg.norm(rec.omega[start:hi][:, f], axis=2) * self.radius[f] > v_tol)).any(axis=1)
+        fast = (np.linalg.norm(vel, axis=2) > v_tol) | (np.linalg.norm(rec.omega[start:hi][:, f], axis=2) * self.radius[f] > v_tol)
+
+        def window(x: np.ndarray) -> np.ndarray:  # (frames-length+1, blocks, ..., length)
+            return np.lib.stride_tricks.sliding_window_view(x, length, axis=0)
 
         def spread(x: np.ndarray) -> np.ndarray:  # (frames-length+1, blocks) largest ptp over the window
-            w = np.lib.stride_tricks.sliding_window_view(x, length, axis=0)
+            w = window(x)
             return (w.max(axis=-1) - w.min(axis=-1)).max(axis=-1)
 
-        still = (spread(pos) <= REST_DISPLACEMENT * d).all(axis=1)
-        still &= (spread(rec.quaternion[start:hi][:, f]) <= 0.5 * REST_ROTATION).all(axis=1)
-        still &= ~np.lib.stride_tricks.sliding_window_view(fast, length).any(axis=-1)
-        still &= t[length - 1 :] - self.window >= self.t_input - 1e-12
+        tk = t[length - 1 :]
+        gone = (off[f] >= 0.0)[None, :] & (off[f][None, :] <= tk[:, None] + 1e-9 * max(1.0, float(tk[-1])))
+        still_b = (spread(pos) <= REST_DISPLACEMENT * d) & (spread(rec.quaternion[start:hi][:, f]) <= 0.5 * REST_ROTATION)
+        still_b &= ~window(fast).any(axis=-1)
+        still = (still_b | gone).all(axis=1) & ~gone.all(axis=1)
+        still &= tk - self.window >= self.t_input - 1e-12
         hit = np.flatnonzero(still)
         if not hit.size:
             return None

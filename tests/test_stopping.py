@@ -202,3 +202,38 @@ def test_studies_stop_by_default_and_keep_their_ids_when_off():
     assert off.id == RunSpec.make(example_case("free-rocking"), {"damping.alpha": 1.0}, duration=1.0).id
     with pytest.raises(ValueError, match=r"\[study\] stop must be one of"):
         parse_study({"study": {**study, "stop": "maybe"}})
+
+
+def _thrown(resting: bool):
+    """A 0.3 m cube thrown clear of a 0.6 m foundation at 6 m/s (it leaves the supports about 0.07 s
+    later), and, with ``resting``, a 0.2 m cube resting on the foundation's far corner."""
+    from rockdem.specimens import add_foundation
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1e9 / 0.3, friction_angle=30)
+    add_foundation(b, 0.6)
+    b.add_box(0.3, 0.3, 0.3, base_center=(0.1, 0.1, 0), density=2000, name="cube", velocity=(6.0, 0, 0))
+    if resting:
+        b.add_box(0.2, 0.2, 0.2, base_center=(-0.2, -0.2, 0), density=2000, name="resting")
+    return b.finalize(damping=Damping(beta=2e-4))
+
+
+def test_a_block_thrown_clear_of_the_supports_has_fallen_and_the_rest_may_come_to_rest():
+    """A block that left the supports falls for ever: the collapse rule decides "fell" at the frame
+    the engine noted it (also for a single free block, judged otherwise by overturning), and the
+    rest rule leaves it out, so that the block still on the foundation can be found at rest. Before
+    2026-11-28 both runs went on to their end (the falling block never rests, nor overturns)."""
+    for stop in ("collapse", "decided"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ds = simulate(_thrown(False), 3.0, record_interval=0.005, progress=False, stop=stop)
+        t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+        assert ds.attrs["stop_reason"] == "fell" and ds.attrs["stop_block"] == "cube"
+        assert ds.attrs["stop_time"] == pytest.approx(t_off, abs=1e-9) and t_off < 0.5
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = simulate(_thrown(True), 6.0, record_interval=0.005, progress=False, stop="rest")
+    assert ds.attrs["stop_reason"] == "rest" and ds.attrs["stop_time"] < 3.0
+    assert ds.attrs["fell_off_blocks"] == "cube"
+    v = ds.block_velocity.sel(block="resting").values[-1]
+    assert np.linalg.norm(v) < REST_SPEED * math.sqrt(G * 0.2)
