@@ -124,7 +124,7 @@ def test_a_sliding_block_s_dashpots_never_do_positive_work(speed):
     decreases below zero and kinetic + potential + elastic never rise above the start. Before
     2026-11-28 a point opening after a slipping step had the negative release share of a shear
     dashpot it never had applied: at 1 m/s -0.15 J booked as damping (0.55 % of the kinetic
-    energy), at 6 m/s 15 J and the cube sped up."""
+    energy), at 6 m/s -33 J (3.4 %) and the cube sped up."""
     b = ModelBuilder(points=(2, 2))
     b.default_material = JointMaterial(kn=1e9 / 0.3, friction_angle=30)
     b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
@@ -135,6 +135,38 @@ def test_a_sliding_block_s_dashpots_never_do_positive_work(speed):
     assert damp.min() >= -1e-9 * mech[0] and np.diff(damp).min() >= -1e-9 * mech[0]
     assert np.max(mech - mech[0]) <= 1e-9 * mech[0]
     assert float(ds.block_velocity.values[-1, 1, 0]) < speed  # friction slows it
+
+
+def test_an_edge_contact_sliding_as_it_releases_gets_no_shear_dashpot_back():
+    """The edge-edge contact (EDGE pair) of two 0.4 m boxes whose ridges cross, the upper one
+    striking at 0.1 m/s while sliding at 0.67 m/s across the lower ridge, no gravity: it slips
+    throughout and bounces off. Its release has no shear dashpot either (kernels.forces._edge_pair,
+    as for face sub-contacts above): the SP damping energy only grows, and at the default step it
+    is within 3 % of the converged value (resolution 0.02). Before 2026-11-28 the release added a
+    shear dashpot the slipping contact never had: 1.02 J against 0.57 J converged (0.556 J now)."""
+    from rockdem.geometry import box
+    from rockdem.kernels.rotation import axis_angle_matrix
+
+    def run(resolution):
+        b = ModelBuilder(points=(2, 2), gravity=(0.0, 0.0, 0.0))
+        b.default_material = JointMaterial(kn=6e9, friction_angle=30.0)
+        s, gap = 0.4, 0.002
+        half = s / math.sqrt(2.0)
+        low = box(s, s, s, name="low").transformed(axis_angle_matrix(np.array([1.0, 0, 0]), math.radians(45)), [0, 0, -half])
+        up = box(s, s, s, name="up").transformed(axis_angle_matrix(np.array([0, 1.0, 0]), math.radians(45)), [0, 0, half + gap])
+        b.add_block(low, density=2000, name="low", driven=True)
+        b.add_block(up, density=2000, name="up", velocity=(0.3, 0.6, -0.1))
+        return simulate(b.finalize(damping=Damping(beta=5e-4)), gap / 0.1 + 0.05, record_interval=2e-5, progress=False,
+                        resolution=resolution)
+
+    ds = run(None)
+    mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
+    damp = ds.energy_damping_stiffness.values
+    assert float(ds.energy_friction.values[-1]) > 0.5 * (mech[0] - mech[-1])  # it slid
+    assert damp[-1] > 0.0 and np.diff(damp).min() >= -1e-9 * mech[0]
+    assert np.max(mech - mech[0]) <= 1e-9 * mech[0]
+    converged = float(run(0.02).energy_damping_stiffness.values[-1])
+    assert damp[-1] == pytest.approx(converged, rel=0.03)
 
 
 def test_coupled_blocks_converge_and_match_the_converged_answer():
