@@ -423,3 +423,30 @@ def test_alpha_that_overdamps_an_assembly_is_warned_about():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         parse_case(apply_overrides(data, ["damping.alpha=1"]))
+
+
+def test_a_block_falling_past_the_trailing_edge_of_a_displaced_foundation_falls_on():
+    """A frictionless 0.2 m cube on a 1 m foundation that slides away under it at 1 m/s along -x:
+    the cube tips over the foundation's trailing edge and falls past it. It left the supports:
+    below the extent it is not under the foundation where that is now. Before 2026-11-28 the
+    footprint at the start widened by the displacement still covered the cube's plan, and the run
+    stopped as "fell through its support" (El Centro's parapet variants: a brick off the trailing
+    edge, 17 m below)."""
+    from rockdem.model import Motion
+    from rockdem.simulation import simulate
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1e9, friction_angle=0.0)
+    b.add_box(1.0, 1.0, 0.25, base_center=(0, 0, -0.25), driven=Motion.constant((-1.0, 0.0, 0.0)), name="foundation")
+    b.add_box(0.2, 0.2, 0.2, base_center=(0.3, 0, 0), density=2000, name="cube")
+    m = b.finalize(damping=Damping(beta=1e-4))
+    with pytest.warns(RuntimeWarning, match="fell off the edge"):
+        ds = simulate(m, 1.2, progress=False)
+    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(1.2, abs=1e-3)
+    assert ds.attrs["fell_off_blocks"] == "cube"
+    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+    k = int(np.searchsorted(ds.time.values, t_off))
+    x = float(ds.block_position.sel(block="cube").values[k, 0])
+    trailing_edge = float(ds.block_position.sel(block="foundation").values[k, 0]) + 0.5
+    # Where it left the extent: within the foundation's plan at the start, past it where it is now.
+    assert m.arrays.support_low[0] <= x <= m.arrays.support_high[0] and trailing_edge < x

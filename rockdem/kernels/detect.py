@@ -454,7 +454,17 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
     prev = _previous_pair(m, sc, a, b)
     keep = -1
     s.pair_from_edge[i] = prev >= 0 and sc.prev_pair_kind[prev] == PAIR_EDGE and sc.prev_pair_normal_force[prev] > 0.0
-    if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE is released)
+    sc.pair_handover[i] = -1.0
+    if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_EDGE:
+        # The edge spring's energy goes to the face sub-contacts at their first law pass
+        # (forces._hand_over_face), not to the released edges' dissipation. An unloaded edge
+        # spring (its overlap taken into its set at its own hand-over) hands over none: the face
+        # springs start unloaded at their overlaps.
+        fn = sc.prev_pair_normal_force[prev]
+        area = min(m.edge_area[sc.prev_pair_edge_a[prev]], m.edge_area[sc.prev_pair_edge_b[prev]])
+        sc.pair_handover[i] = 0.5 * fn * fn / (m.mat_kn[m.block_group[a], m.block_group[b]] * area)
+        sc.prev_pair_normal_force[prev] = 0.0
+    if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
         for f in (sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]):
             if m.face_block[f] == oth:
@@ -535,6 +545,7 @@ def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
     s.slot_area[p, k] = 0.0
     s.slot_overlap[p, k] = 0.0
     s.slot_set[p, k] = 0.0
+    s.slot_cover[p, k] = 0.0
     s.slot_stiffening[p, k] = 1.0
 
 
@@ -582,6 +593,7 @@ def _assign_slots(m: ModelArrays, s: State, sc: Scratch, ncand: int) -> None:
                 s.slot_area[p, k] = 0.0
                 s.slot_overlap[p, k] = 0.0
                 s.slot_set[p, k] = 0.0
+                s.slot_cover[p, k] = 0.0
                 s.slot_stiffening[p, k] = 1.0
                 sc.seen[SLOTS * p + k] = passid
                 sc.cand_slot[c] = k
@@ -622,6 +634,10 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
     _world_vertices(m, s, sc)
     sc.passes[0] += 1
     npair = s.pair_count[0]
+    for i in range(npair):
+        if sc.pair_handover[i] >= 0.0:  # detected again before its law pass (buffers enlarged): dissipated
+            s.energy[E_FRICTION] += sc.pair_handover[i]
+            sc.pair_handover[i] = -1.0
     sc.prev_pair_count[0] = npair
     for i in range(npair):
         sc.prev_pair_a[i] = s.pair_a[i]

@@ -207,23 +207,41 @@ def corner_stiffening(
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def area_change(
-    slot_set: np.ndarray, p: int, j: int, un: float, un_prev: float, area: float, prev_area: float, kn: float
+def cover_change(
+    slot_set: np.ndarray, p: int, j: int, un: float, un_prev: float, area: float, prev_area: float, kn: float,
+    deepened: float, areas: bool,
 ) -> tuple[float, float]:
-    """Overlap [m] of an unbonded sub-contact whose effective area went from ``prev_area`` to
-    ``area`` [m^2] in the last step at overlap ``un`` (measured from its set ``slot_set[p, j]``
-    [m]), and the energy [J] dissipated. Compressed at both steps, a growing area keeps the spring
-    energy: the set rises so that kn A u^2 / 2 is that of the last area; a shrinking one loses
-    kn (A_prev - A) u^2 / 2 (returned). The set follows the overlap down, to 0 once it opens."""
+    """Overlap [m] of an unbonded partly covered sub-contact whose cover changed in the last step,
+    and the energy [J] dissipated: its overlap ``un`` is measured from its set ``slot_set[p, j]``
+    [m], and the cover changed it by ``deepened`` [m] at the present pose (the cover weight of
+    :func:`rockdem.kernels.faces.partly_covered`) and, with ``areas``, its effective area from
+    ``prev_area`` to ``area`` [m^2].
+
+    The cover moves without work, so it must not load the spring: an overlap it deepens raises the
+    set by as much (the spring keeps its energy), one it makes shallower lowers the set first and
+    releases the rest (dissipated, returned). Compressed at both steps, a growing area keeps the
+    spring energy: the set rises so that kn A u^2 / 2 is that of the last area; a shrinking one
+    loses kn (A_prev - A) u^2 / 2. The set follows the overlap down, to 0 once it opens."""
     st = slot_set[p, j]
     e = 0.0
-    if un > 0.0 and un_prev > 0.0 and prev_area > 0.0 and area > 0.0:
+    if deepened > 0.0 and un > 0.0:
+        r = min(deepened, un)
+        st += r
+        un -= r
+    elif deepened < 0.0:
+        r = min(-deepened, st)
+        st -= r
+        un += r
+        before = un - deepened - r  # the overlap the old cover gave (> un)
+        if before > 0.0:
+            e = 0.5 * kn * area * (before * before - max(un, 0.0) ** 2)
+    if areas and un > 0.0 and un_prev > 0.0 and prev_area > 0.0 and area > 0.0:
         if area > prev_area:
             kept = un * math.sqrt(prev_area / area)
             st += un - kept
             un = kept
         elif area < prev_area:
-            e = 0.5 * kn * (prev_area - area) * un * un
+            e += 0.5 * kn * (prev_area - area) * un * un
     elif st > 0.0 and un < 0.0:
         st = max(st + un, 0.0)  # opened: the set comes down to the geometric overlap st + un, or 0
     slot_set[p, j] = st
@@ -314,13 +332,62 @@ def _faces(s: State, i: int, side: int) -> tuple[int, int]:
     return s.pair_target_face[i], s.pair_owner_face[i]
 
 
+@njit(cache=True, _nrt=False)
+def _hand_over_face(m: ModelArrays, s: State, sc: Scratch, i: int, a: int, b: int, budget: float) -> bool:
+    """After the first law pass of FACE pair i (blocks a, b), formed at this detection from an
+    EDGE pair whose normal spring held ``budget`` [J] (0 unloaded): whether the pass must run again.
+
+    The contact changes representation under load (a cube tipping over a foundation's edge held
+    by its edge, then by its face's sub-contacts); the face springs start with no more energy than
+    the edge spring held, as :func:`rockdem.kernels.detect.hand_over_edge` does the other way. If
+    their overlaps would hold more, each compressed sub-contact starts unloaded at a *set*
+    (``s.slot_set``, followed down as it opens) that scales its overlap by sqrt(budget / held),
+    its slot is reset to new (but for its overlap: it continues the edge's contact, and is not
+    ramped in as a contact closing in the step) and True is returned; otherwise what they hold
+    less is booked as dissipated. Before 2026-11-28 the edge's energy was booked as dissipated and the face springs
+    started loaded: a frictionless cube sliding over a foundation's edge gained 0.25 J in one step
+    (its sub-contacts 0.1-0.27 mm deep under the edge). A pair whose slots carry history (not new
+    at this detection) books the budget as dissipated, as before."""
+    kn = m.mat_kn[m.block_group[a], m.block_group[b]]
+    held = 0.0
+    for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+        code = s.track[k]
+        p = code // SLOTS
+        j = code - SLOTS * p
+        if s.slot_bonded[p, j] or s.slot_set[p, j] != 0.0:
+            sc.side_friction[i, 0] += budget  # not new: handed over as before
+            return False
+        u = s.slot_overlap[p, j]
+        if u > 0.0:
+            held += 0.5 * kn * s.slot_area[p, j] * u * u
+    if held <= budget:
+        sc.side_friction[i, 0] += budget - held
+        return False
+    f = 1.0 - math.sqrt(budget / held)
+    for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+        code = s.track[k]
+        p = code // SLOTS
+        j = code - SLOTS * p
+        u = max(s.slot_overlap[p, j], 0.0)
+        s.slot_set[p, j] = f * u
+        s.slot_overlap[p, j] = u - f * u  # pressed at the last step (the edge's contact goes on): no closing ramp
+        s.slot_area[p, j] = 0.0
+        s.slot_cover[p, j] = 0.0
+        s.slot_stiffening[p, j] = 1.0
+        s.slot_normal_force[p, j] = 0.0
+        s.slot_shear[p, j, 0] = 0.0
+        s.slot_shear[p, j, 1] = 0.0
+        s.slot_shear[p, j, 2] = 0.0
+    return True
+
+
 @njit(cache=True, _nrt=False, inline="always")
 def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray) -> None:
     """The cover and joint law of the sub-contacts of FACE pair i (``buf``: a (2, 32, 2) polygon
     buffer of the calling thread's own). Writes only pair i's entries: its sub-contacts' slots,
-    forces and flags (``sc.track_released``, ``sc.track_failed``) and per side the resultant,
-    energies and counts (``sc.side_*``) that :func:`_gather` adds up in pair order, so that pairs
-    may run in parallel with the serial answer bit for bit.
+    forces and flags (``sc.track_released``, ``sc.track_failed``), its ``sc.pair_handover`` and
+    per side the resultant, energies and counts (``sc.side_*``) that :func:`_gather` adds up in
+    pair order, so that pairs may run in parallel with the serial answer bit for bit.
 
     Performance note: the joint law (:func:`_law_range`) calls only small inlined functions and
     makes no array views. A call to a compiled function, or an inlined one with loops of its own
@@ -337,24 +404,32 @@ def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, implicit
     b = m.face_block[fb]
     split = s.pair_track_split[i]
     stop = s.pair_track_stop[i]
-    lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
-    # The owner's points on the target face, then (while the pair may blend) the target's on
-    # the owner face: one call site, so that the inlined joint law is compiled once.
-    u_owner = 0.0
-    for side in range(2 if split < stop else 1):
-        if side == 0:
-            k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
-        else:
-            k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
-        u_side = _law_range(m, s, sc, i, side, k0, k1, fo, ft, o, t, wgt, blending, dt, implicit, dashpots, buf)
-        if side == 0:
-            u_owner = u_side
-        elif dlam != 0.0:
-            # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
-            g = (u_side - u_owner) * dlam
-            for c in range(3):
-                sc.blend_force_owner[i, c] *= g
-                sc.blend_force_target[i, c] *= g
+    budget = sc.pair_handover[i]
+    sc.pair_handover[i] = -1.0
+    # A pair formed from an EDGE pair runs its law twice at its first pass when its
+    # sub-contacts would hold more than the edge spring held (_hand_over_face).
+    for _ in range(2):
+        lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
+        # The owner's points on the target face, then (while the pair may blend) the target's on
+        # the owner face: one call site, so that the inlined joint law is compiled once.
+        u_owner = 0.0
+        for side in range(2 if split < stop else 1):
+            if side == 0:
+                k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
+            else:
+                k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
+            u_side = _law_range(m, s, sc, i, side, k0, k1, fo, ft, o, t, wgt, blending, dt, implicit, dashpots, buf)
+            if side == 0:
+                u_owner = u_side
+            elif dlam != 0.0:
+                # The weight's own energy gradient: sc.blend_* hold the unit force pairs of grad c.
+                g = (u_side - u_owner) * dlam
+                for c in range(3):
+                    sc.blend_force_owner[i, c] *= g
+                    sc.blend_force_target[i, c] *= g
+        if budget < 0.0 or not _hand_over_face(m, s, sc, i, a, b, budget):
+            break
+        budget = -1.0
 
 
 @njit(cache=True, _nrt=False)
@@ -522,19 +597,20 @@ def _law_range(
         code = s.track[k]
         p = code // SLOTS
         j = code - SLOTS * p
+        cover_w = phi = 0.0
         if mask == 0:
             full_area, yu, yw, shift = m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
         elif mask == -2:
             full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
         else:
             unbonded = not s.slot_bonded[p, j]
-            full_area, yu, yw, shift = cut_cell(
+            full_area, yu, yw, shift, cover_w, phi = cut_cell(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
                 unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
-            shift -= s.slot_set[p, j]  # a partly covered cell's set (below): its overlap is measured from it
+        shift -= s.slot_set[p, j]  # an unbonded sub-contact's set (below): its overlap is measured from it
         sc.track_point_u[k] = yu
         sc.track_point_w[k] = yw
         sc.track_depth_shift[k] = shift
@@ -590,16 +666,24 @@ def _law_range(
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
         bonded = s.slot_bonded[p, j]
         prev_area = s.slot_area[p, j]
-        if cut and not bonded and not blending:
-            # A partly covered cell whose area changes under load (its cover slides): the spring
-            # kn A u^2 / 2 would gain or lose kn u^2 dA / 2 without work. It keeps its energy as
-            # the area grows (its overlap is measured from a set, s.slot_set, which follows the
-            # overlap down as it opens) and what it holds less as the area shrinks is dissipated
-            # (an ended stiffening is booked above: the areas are compared at the same factor).
+        if not bonded and (cut or s.slot_set[p, j] > 0.0):
+            # A partly covered cell whose cover slides under load: the spring kn A u^2 / 2 would
+            # gain or lose energy without work, as its area changes (kn u^2 dA / 2) and as its
+            # cover weight w moves its overlap u = u_p + w phi(g) at a fixed pose (kernels.faces;
+            # a cube on a foundation sliding away under it, frictionless, gained 0.05 J of its
+            # 0.05 J scale as the foundation's edge passed under its cell boundary, before
+            # 2026-11-28). It keeps its energy as the area grows or w deepens it (its overlap is
+            # measured from a set, s.slot_set, which follows the overlap down as it opens) and
+            # what it holds less as they shrink it is dissipated (an ended stiffening is booked
+            # above: the areas are compared at the same factor). Inside a blend the area's change
+            # comes with the blend weight's, whose energy gradient is applied (kernels.blend): only w's is.
+            # (A wholly covered cell has a set when its pair took over from an edge, _hand_over_face.)
             un_cover = un
-            un, e_set = area_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn)
+            deepened = (cover_w - s.slot_cover[p, j]) * phi if prev_area > 0.0 else 0.0
+            un, e_set = cover_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn, deepened, cut and not blending)
             sc.track_depth_shift[k] = shift + (un - un_cover)
             e_fric += e_set
+        s.slot_cover[p, j] = cover_w
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         s.slot_area[p, j] = area
         vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
@@ -1003,6 +1087,6 @@ def compute_forces(m: ModelArrays, s: State, sc: Scratch, t: float, dt: float) -
 
 
 compute_forces_parallel = njit(cache=True, _nrt=False, inline="always")(
-    rebind(compute_forces.py_func, "compute_forces_parallel", _law_pass=_law_pass_parallel)
+    rebind(getattr(compute_forces, "py_func", compute_forces), "compute_forces_parallel", _law_pass=_law_pass_parallel)
 )
 """(m, s, sc, t, dt) -> None: :func:`compute_forces` with :func:`_law_pass_parallel`."""

@@ -169,8 +169,10 @@ class State(NamedTuple):
     slot_normal_force: np.ndarray  # (np, SLOTS) [N] elastic normal force (compression > 0)
     slot_area: np.ndarray  # (np, SLOTS) [m^2] effective area: the cell area the partner covers
     slot_overlap: np.ndarray  # (np, SLOTS) [m] normal overlap at the last force pass (> 0 compression), less slot_set
-    slot_set: np.ndarray  # (np, SLOTS) [m] overlap at which a partly covered unbonded cell's spring is
-    # unloaded (>= 0; forces.area_change: its area grew under load)
+    slot_set: np.ndarray  # (np, SLOTS) [m] overlap at which an unbonded sub-contact's spring is unloaded (>= 0:
+    # forces.cover_change, its cover grew under load; forces._hand_over_face, it took over from an edge spring)
+    slot_cover: np.ndarray  # (np, SLOTS) [-] cover weight of a partly covered cell at the last force pass
+    # (kernels.faces.partly_covered; 0 wholly covered): its change at a pose is a cover change (forces.cover_change)
     slot_bonded: np.ndarray  # (np, SLOTS) bool
     slot_stiffening: np.ndarray  # (np, SLOTS) [-] area factor of a corner that landed alone (vertex-face contact), 1 otherwise
     point_failed: np.ndarray  # (np,) int64 FAILED_*
@@ -249,6 +251,8 @@ class Scratch(NamedTuple):
     pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
     pair_asks_detection: np.ndarray  # (P,) bool FACE: its target's points are needed but not tracked (law pass to gather)
+    pair_handover: np.ndarray  # (P,) [J] FACE formed at this detection from an EDGE pair: the normal spring
+    # energy it held (0 unloaded), for the first law pass (forces._hand_over_face); -1 none
     # FACE pairs per side (0: the owner's points, 1: the target's), from the law pass to its gather:
     side_force: np.ndarray  # (P, 2, 3) [N] resultant of the side's sub-contact forces on its pressing block
     side_moment: np.ndarray  # (P, 2, 3) [N m] their moment about that block's centroid

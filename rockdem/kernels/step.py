@@ -414,16 +414,36 @@ def _driven_shift(m: ModelArrays, s: State, rec: Records, i: int) -> tuple[float
 
 
 @njit(cache=True, _nrt=False)
+def _under_a_support(m: ModelArrays, s: State, sc: Scratch, x: float, y: float) -> bool:
+    """Whether the plan point (x, y) [m] lies within the current plan (x, y bounding box of its
+    vertices) of a driven block."""
+    for b in range(m.block_mass.shape[0]):
+        if m.block_free[b]:
+            continue
+        r = sc.rotation[b]
+        x0 = y0 = np.inf
+        x1 = y1 = -np.inf
+        for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
+            p = m.vertex_local[v]
+            wx = s.position[b, 0] + r[0, 0] * p[0] + r[0, 1] * p[1] + r[0, 2] * p[2]
+            wy = s.position[b, 1] + r[1, 0] * p[0] + r[1, 1] * p[1] + r[1, 2] * p[2]
+            x0, x1, y0, y1 = min(x0, wx), max(x1, wx), min(y0, wy), max(y1, wy)
+        if x0 <= x <= x1 and y0 <= y <= y1:
+            return True
+    return False
+
+
+@njit(cache=True, _nrt=False)
 def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int) -> int:
     """Status of recorded frame ``frame``: STATUS_DIVERGED when the state is not finite or energy
     was created: the mechanical energy (kinetic + potential + elastic) exceeds its initial value
     plus the work done on the model by more than DIVERGENCE_ERROR of the energy scale reached so far
     (kinetic + elastic + |potential change| + dissipated + |work|, at least the work of lifting the
     free blocks by 1 mm); STATUS_LOST when a free block's centroid left the model's extent through
-    its bottom inside the plan footprint of the driven blocks (it fell through its support) or
-    through its top (it flew away); else STATUS_DONE (the extent and the footprint move with the
-    driven blocks). ``sc.lost_block`` names the block (-1 for an energy divergence). A block leaving
-    the extent through its bottom outside the footprint, or through a side (thrown clear of the
+    its bottom under a driven block's current plan (it fell through its support) or
+    through its top (it flew away); else STATUS_DONE (the extent moves with the driven blocks).
+    ``sc.lost_block`` names the block (-1 for an energy divergence). A block leaving the extent
+    through its bottom beside the driven blocks' current plans, or through a side (thrown clear of the
     supports, it is falling), has left the supports: its time is noted in ``s.fell_off`` and it
     falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
     recorded balance error but is not a divergence.)"""
@@ -442,8 +462,9 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     sc.lost_block[0] = -1
     if not (math.isfinite(err) and err <= DIVERGENCE_ERROR * sc.energy_scale[0]):
         return STATUS_DIVERGED
-    # The extent and the footprint move with the driven blocks (a foundation under a ground motion
-    # carries the blocks on it): widened by their displacement since the first frame.
+    # The extent (and the quick test of the footprint below) moves with the driven blocks (a
+    # foundation under a ground motion carries the blocks on it): widened by their displacement
+    # since the first frame.
     lx, hx = _driven_shift(m, s, rec, 0)
     ly, hy = _driven_shift(m, s, rec, 1)
     lz, hz = _driven_shift(m, s, rec, 2)
@@ -458,8 +479,12 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
         outside = (high or z < m.extent_low[2] + lz or x < m.extent_low[0] + lx or x > m.extent_high[0] + hx
                    or y < m.extent_low[1] + ly or y > m.extent_high[1] + hy)
         if outside:
+            # Under a driven block where it is now: the footprint at the start widened by the
+            # driven blocks' displacement is only a quick test (a foundation displaced by +d still
+            # covered its old trailing edge there: a brick that fell just past that edge, 17 m
+            # below, read as fallen through it, and the run stopped; parapet_pacoima_x2_strong).
             on_support = (m.support_low[0] + lx <= x <= m.support_high[0] + hx
-                          and m.support_low[1] + ly <= y <= m.support_high[1] + hy)
+                          and m.support_low[1] + ly <= y <= m.support_high[1] + hy) and _under_a_support(m, s, sc, x, y)
             if not high and not on_support:  # below the top, beside the supports: it left them
                 s.fell_off[b] = rec.time[frame]
                 continue
@@ -542,7 +567,7 @@ def advance(
     return frame, STATUS_DONE
 
 
-advance_parallel = njit(cache=True, _nrt=False)(rebind(advance.py_func, "advance_parallel", compute_forces=compute_forces_parallel))
+advance_parallel = njit(cache=True, _nrt=False)(rebind(getattr(advance, "py_func", advance), "advance_parallel", compute_forces=compute_forces_parallel))
 """(m, s, sc, t_stop, record_interval, rec, frame) -> (frame, status): :func:`advance` with the face
 pairs' joint law on Numba's threads (:func:`rockdem.kernels.forces.compute_forces_parallel`): the
 same answer bit for bit on any number of threads. Compiled on first use only (a one-thread run
