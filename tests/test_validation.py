@@ -383,12 +383,22 @@ def test_a_block_falling_off_the_edge_of_its_foundation_falls_on_and_the_run_com
     assert np.max(mech - mech[0]) <= 1e-3 * float(ds.block_mass[1]) * 9.81
 
 
+def _run_until_the_cube_falls_off(m, duration: float):
+    """Run ``m`` for ``duration`` [s]: it must reach its end, the block "cube" named (and warned
+    about) as having left the supports. Returns (result, the time it left [s], that frame)."""
+    with pytest.warns(RuntimeWarning, match="fell off the edge"):
+        ds = simulate(m, duration, progress=False)
+    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(duration, abs=1e-3)
+    assert ds.attrs["fell_off_blocks"] == "cube"
+    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+    return ds, t_off, int(np.searchsorted(ds.time.values, t_off))
+
+
 def test_a_block_thrown_clear_of_a_small_foundation_falls_on_and_the_run_completes():
     # A cube sliding off a 0.6 m foundation at 6 m/s flies clear of it and leaves the model's
     # extent (1 m beyond the blocks) through its side, not its bottom, while falling. It has left
     # the supports, as one falling over their edge: the run goes on to its end (before 2026-11-28
     # it stopped as "lost", a divergence), names it, and the cube is in free flight after it left.
-    from rockdem.simulation import simulate
     from rockdem.specimens import add_foundation
 
     b = ModelBuilder(points=(2, 2))
@@ -396,13 +406,8 @@ def test_a_block_thrown_clear_of_a_small_foundation_falls_on_and_the_run_complet
     add_foundation(b, 0.6)
     b.add_box(0.3, 0.3, 0.3, base_center=(0, 0, 0), density=2000, name="cube", velocity=(6.0, 0, 0))
     m = b.finalize(damping=Damping(beta=1e-4))
-    with pytest.warns(RuntimeWarning, match="fell off the edge"):
-        ds = simulate(m, 0.6, progress=False)
-    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(0.6, abs=1e-3)
-    assert ds.attrs["fell_off_blocks"] == "cube"
-    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
+    ds, t_off, i_off = _run_until_the_cube_falls_off(m, 0.6)
     x, z = ds.block_position.sel(block_id=1).values[:, 0], ds.block_position.sel(block_id=1).values[:, 2]
-    i_off = int(np.searchsorted(ds.time.values, t_off))
     assert x[i_off] > m.arrays.extent_high[0] and z[i_off] > m.arrays.extent_low[2]  # it left through the side
     late = ds.time.values > t_off
     v = ds.block_velocity.sel(block_id=1).values[late]
@@ -433,19 +438,13 @@ def test_a_block_falling_past_the_trailing_edge_of_a_displaced_foundation_falls_
     stopped as "fell through its support" (El Centro's parapet variants: a brick off the trailing
     edge, 17 m below)."""
     from rockdem.model import Motion
-    from rockdem.simulation import simulate
 
     b = ModelBuilder(points=(2, 2))
     b.default_material = JointMaterial(kn=1e9, friction_angle=0.0)
     b.add_box(1.0, 1.0, 0.25, base_center=(0, 0, -0.25), driven=Motion.constant((-1.0, 0.0, 0.0)), name="foundation")
     b.add_box(0.2, 0.2, 0.2, base_center=(0.3, 0, 0), density=2000, name="cube")
     m = b.finalize(damping=Damping(beta=1e-4))
-    with pytest.warns(RuntimeWarning, match="fell off the edge"):
-        ds = simulate(m, 1.2, progress=False)
-    assert ds.attrs.get("diverged", 0) == 0 and float(ds.time[-1]) == pytest.approx(1.2, abs=1e-3)
-    assert ds.attrs["fell_off_blocks"] == "cube"
-    t_off = float(np.atleast_1d(ds.attrs["fell_off_times"])[0])
-    k = int(np.searchsorted(ds.time.values, t_off))
+    ds, _, k = _run_until_the_cube_falls_off(m, 1.2)
     x = float(ds.block_position.sel(block="cube").values[k, 0])
     trailing_edge = float(ds.block_position.sel(block="foundation").values[k, 0]) + 0.5
     # Where it left the extent: within the foundation's plan at the start, past it where it is now.
