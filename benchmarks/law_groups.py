@@ -1,0 +1,89 @@
+"""The joint law's cost per sub-contact by kind of face pair, on the settled 1000-brick wall (one
+thread). Run: ``python benchmarks/law_groups.py`` (prints figures; about a minute and a half with
+a warm cache, most of it compiling this script's loops).
+
+The wall of ``bench_engine.py wall`` settles for 0.02 s. Its face pairs are split by how the
+target face covers the owner face (``faces.crossing_lines``): *flush* (no target edge line
+crosses the owner face: bed and head joints), *cut* (cells clipped by a target edge line: the
+head faces of diagonal neighbours, overlapping by the sliver of the settlement difference) and
+faces at right angles. Each group's law (``forces._law_pair``) runs 100 times on a copy of the
+settled state, best of three rounds (docs/performance.md, "A third machine").
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+from numba import njit
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_engine import wall_model  # noqa: E402
+
+from rockdem.kernels.faces import crossing_lines, face_map_arrays  # noqa: E402
+from rockdem.kernels.forces import _law_pair  # noqa: E402
+from rockdem.kernels.layout import PAIR_EDGE  # noqa: E402
+from rockdem.simulation import prepare_start, run_model  # noqa: E402
+
+EDGE = -9  # an EDGE pair (no cover)
+RIGHT_ANGLES = -2  # crossing_lines' code for faces whose map is singular
+
+
+@njit(_nrt=False)
+def _cover_kinds(m, s, sc, out):  # type: ignore[no-untyped-def]
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            out[i] = EDGE
+            continue
+        fo, ft = s.pair_owner_face[i], s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        out[i] = RIGHT_ANGLES if abs(fm.det) < 1e-9 else crossing_lines(
+            m.face_corner_start, m.face_corner_uw, m.face_line_start, m.face_line, fo, ft, fm)
+
+
+@njit(_nrt=False)  # _nrt=False as the engine's kernels: the inlined law needs it to run at speed
+def _laws(m, s, sc, dt, pairs, reps):  # type: ignore[no-untyped-def]
+    for _ in range(reps):
+        for i in pairs:
+            _law_pair(m, s, sc, i, dt, False, False, sc.poly)
+
+
+def main() -> None:
+    numba.set_num_threads(1)
+    model = wall_model()
+    start = prepare_start(model)
+    run_model(model, 0.02, record_interval=0.01, progress=False, start=start, threads=1)
+    m, s = model.arrays, start.state
+    n = int(s.pair_count[0])
+    kind = np.zeros(n, dtype=np.int64)
+    _cover_kinds(m, s, start.scratch, kind)
+    per_pair = s.pair_track_stop[:n] - s.pair_track_start[:n]
+    dt = float(s.dt[0])
+    groups = {
+        "flush": np.flatnonzero(kind == 0),
+        "cut": np.flatnonzero((kind != 0) & (kind != RIGHT_ANGLES) & (kind != EDGE)),
+        "right angles": np.flatnonzero(kind == RIGHT_ANGLES),
+        "all face pairs": np.flatnonzero(kind != EDGE),
+    }
+    copy = start.copy()
+    _laws(m, copy.state, copy.scratch, dt, groups["all face pairs"], 1)  # compile
+    print(f"1000-brick wall settled 0.02 s: {n} pairs")
+    print(f"{'face pairs':>15} {'pairs':>6} {'sub-contacts':>12} {'ms per pass':>11} {'ns per sub-contact':>18}")
+    for name, pairs in groups.items():
+        if pairs.size == 0:
+            continue
+        best = np.inf
+        for _ in range(3):
+            copy = start.copy()
+            t0 = time.perf_counter()
+            _laws(m, copy.state, copy.scratch, dt, pairs, 100)
+            best = min(best, (time.perf_counter() - t0) / 100)
+        count = int(per_pair[pairs].sum())
+        print(f"{name:>15} {pairs.size:>6} {count:>12} {1e3 * best:>11.3f} {1e9 * best / count:>18.0f}")
+
+
+if __name__ == "__main__":
+    main()
