@@ -27,6 +27,7 @@ import numpy as np
 from numba import njit
 
 from .blend import face_clearance, tracks_target
+from .contact import spring_energy
 from .faces import cover, face_map
 from .layout import (
     E_BOND,
@@ -348,6 +349,20 @@ def edge_contact(m: ModelArrays, s: State, sc: Scratch, i: int) -> tuple[float, 
     return un, n0, n1, n2, 0.5 * (qa0 + qb0), 0.5 * (qa1 + qb1), 0.5 * (qa2 + qb2)
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _prev_edge_area(edge_area: np.ndarray, sc: Scratch, k: int) -> float:
+    """Contact area [m^2] of the previous detection's EDGE pair k: the smaller of its two edges'
+    (the area its stiffness kn A_e and its energies use)."""
+    return min(edge_area[sc.prev_pair_edge_a[k]], edge_area[sc.prev_pair_edge_b[k]])
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _prev_edge_energy(edge_area: np.ndarray, sc: Scratch, k: int, kn: float) -> float:
+    """Normal spring energy fn^2 / (2 kn A_e) [J] of the previous detection's EDGE pair k (``kn``
+    [Pa/m]: its two blocks' normal stiffness)."""
+    return spring_energy(sc.prev_pair_normal_force[k], kn * _prev_edge_area(edge_area, sc, k))
+
+
 @njit(cache=True, _nrt=False)
 def _pair_face_energy(m: ModelArrays, s: State, a: int, b: int) -> float:
     """Elastic energy [J] of the compressed normal springs of the face sub-contacts between blocks
@@ -362,7 +377,7 @@ def _pair_face_energy(m: ModelArrays, s: State, a: int, b: int) -> float:
                 for k in range(SLOTS):
                     fn = s.slot_normal_force[p, k]
                     if s.slot_partner[p, k] == oth and fn > 0.0 and s.slot_area[p, k] > 0.0:
-                        e += 0.5 * fn * fn / (m.mat_kn[gb, go] * s.slot_area[p, k])
+                        e += spring_energy(fn, m.mat_kn[gb, go] * s.slot_area[p, k])
                         s.slot_normal_force[p, k] = 0.0
     return e
 
@@ -389,9 +404,7 @@ def hand_over_edge(m: ModelArrays, s: State, sc: Scratch, i: int, k: int) -> Non
     budget = 0.0
     if k >= 0:
         if sc.prev_pair_kind[k] == PAIR_EDGE:
-            fn = sc.prev_pair_normal_force[k]
-            area = min(m.edge_area[sc.prev_pair_edge_a[k]], m.edge_area[sc.prev_pair_edge_b[k]])
-            budget = 0.5 * fn * fn / (m.mat_kn[ga, gb] * area)
+            budget = _prev_edge_energy(m.edge_area, sc, k, m.mat_kn[ga, gb])
             sc.prev_pair_normal_force[k] = 0.0  # handed over, not released
         else:
             budget = _pair_face_energy(m, s, a, b)
@@ -460,9 +473,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         # (forces._hand_over_face), not to the released edges' dissipation. An unloaded edge
         # spring (its overlap taken into its set at its own hand-over) hands over none: the face
         # springs start unloaded at their overlaps.
-        fn = sc.prev_pair_normal_force[prev]
-        area = min(m.edge_area[sc.prev_pair_edge_a[prev]], m.edge_area[sc.prev_pair_edge_b[prev]])
-        sc.pair_handover[i] = 0.5 * fn * fn / (m.mat_kn[m.block_group[a], m.block_group[b]] * area)
+        sc.pair_handover[i] = _prev_edge_energy(m.edge_area, sc, prev, m.mat_kn[m.block_group[a], m.block_group[b]])
         sc.prev_pair_normal_force[prev] = 0.0
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
@@ -530,8 +541,7 @@ def release_slot(m: ModelArrays, s: State, p: int, k: int) -> None:
         ks = m.mat_ks[go, gt] * area
         sh = s.slot_shear[p, k]
         e += 0.5 * ks * (sh[0] * sh[0] + sh[1] * sh[1] + sh[2] * sh[2])
-        fn = s.slot_normal_force[p, k]
-        e += 0.5 * fn * fn / (m.mat_kn[go, gt] * area)
+        e += spring_energy(s.slot_normal_force[p, k], m.mat_kn[go, gt] * area)
     if s.slot_bonded[p, k]:
         s.slot_bonded[p, k] = False
         s.point_failed[p] = FAILED_TENSION
@@ -696,12 +706,11 @@ def _release_lost_edges(m: ModelArrays, s: State, sc: Scratch) -> None:
             continue
         a = sc.prev_pair_a[k]
         b = sc.prev_pair_b[k]
-        area = min(m.edge_area[sc.prev_pair_edge_a[k]], m.edge_area[sc.prev_pair_edge_b[k]])
+        area = _prev_edge_area(m.edge_area, sc, k)
         g0, g1 = m.block_group[a], m.block_group[b]
         sh = sc.prev_pair_shear[k]
         e = 0.5 * m.mat_ks[g0, g1] * area * (sh[0] * sh[0] + sh[1] * sh[1] + sh[2] * sh[2])
-        fn = sc.prev_pair_normal_force[k]
-        e += 0.5 * fn * fn / (m.mat_kn[g0, g1] * area)
+        e += _prev_edge_energy(m.edge_area, sc, k, m.mat_kn[g0, g1])
         s.energy[E_FRICTION] += e
 
 
