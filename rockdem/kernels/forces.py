@@ -611,9 +611,6 @@ def _law_range(
                 unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
         shift -= s.slot_set[p, j]  # an unbonded sub-contact's set (below): its overlap is measured from it
-        sc.track_point_u[k] = yu
-        sc.track_point_w[k] = yw
-        sc.track_depth_shift[k] = shift
         if dashpots:
             sc.dashpot_cn[k] = 0.0
             sc.dashpot_force[k, 0] = 0.0
@@ -625,7 +622,6 @@ def _law_range(
         if full_area == 0.0 and s.slot_area[p, j] == 0.0 and not s.slot_bonded[p, j]:
             # Uncovered now and at the last step, unbonded: nothing acts (the opened case below,
             # without computing what it does not use).
-            sc.track_area[k] = 0.0
             s.slot_overlap[p, j] = min(-(fm.h0 + fm.hu * yu + fm.hw * yw) + shift, 0.0)
             s.slot_shear[p, j, 0] = 0.0
             s.slot_shear[p, j, 1] = 0.0
@@ -661,7 +657,6 @@ def _law_range(
             u_held = max(s.slot_overlap[p, j], 0.0) * max(un, 0.0)
             e_fric += 0.5 * s.slot_area[p, j] * (1.0 - 1.0 / ended) * (
                 kn * u_held + ks * (s.slot_shear[p, j, 0] ** 2 + s.slot_shear[p, j, 1] ** 2 + s.slot_shear[p, j, 2] ** 2))
-        sc.track_area[k] = area
         un_prev = s.slot_overlap[p, j]
         us0, us1, us2 = s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2]
         bonded = s.slot_bonded[p, j]
@@ -681,7 +676,7 @@ def _law_range(
             un_cover = un
             deepened = (cover_w - s.slot_cover[p, j]) * phi if prev_area > 0.0 else 0.0
             un, e_set = cover_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn, deepened, cut and not blending)
-            sc.track_depth_shift[k] = shift + (un - un_cover)
+            shift += un - un_cover
             e_fric += e_set
         s.slot_cover[p, j] = cover_w
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
@@ -714,6 +709,12 @@ def _law_range(
                 sc.track_released[k] = True
                 sc.release_overlap[k] = un_prev
                 sc.release_area[k] = prev_area
+                # Where and how large it is now (only the release pass reads these: written here,
+                # not for every sub-contact at every step).
+                sc.track_area[k] = area
+                sc.track_point_u[k] = yu
+                sc.track_point_w[k] = yw
+                sc.track_depth_shift[k] = shift
                 released += 1
                 s.slot_normal_force[p, j] = 0.0
                 continue

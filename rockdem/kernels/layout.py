@@ -232,7 +232,7 @@ class Scratch(NamedTuple):
     dashpot_cs: np.ndarray  # (SLOTS np,) [N s/m] shear dashpot beta ks A (0 while slipping)
     dashpot_normal: np.ndarray  # (SLOTS np, 3) its unit normal, world (into the block the force acts on)
     dashpot_velocity: np.ndarray  # (SLOTS np, 3) [m/s] relative velocity at the last half step (owner minus target)
-    track_area: np.ndarray  # (SLOTS np,) [m^2] effective area of each tracked sub-contact
+    track_area: np.ndarray  # (SLOTS np,) [m^2] effective area of a tracked sub-contact that opened during the last step (for the release pass; not written for the others)
     track_point_u: np.ndarray  # (SLOTS np,) [m] its force point, owner face coordinate u
     track_point_w: np.ndarray  # (SLOTS np,) [m] ... and w
     track_depth_shift: np.ndarray  # (SLOTS np,) [m] overlap at the force point minus its overlap (<= 0, faces.partly_covered)
