@@ -443,6 +443,9 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         state, scratch = ck.engine_arrays(model)
         scratch.lost_block[:] = -1
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
+    if start is not None and state.step[0] == 0:
+        state.velocity_lag[0] = 0.0  # the model's initial velocities are those at t = 0 (a saved state's
+        # are its last half step's: a checkpoint keeps its own lag)
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)

@@ -97,6 +97,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         time=one.copy(),
         dt=one.copy(),
         dt_prev=one.copy(),
+        velocity_lag=one.copy(),
         dt_min=one.copy(),
         safety=one.copy(),
         resolution=one.copy(),

@@ -116,8 +116,9 @@ def test_frames_between_steps_follow_free_flight_exactly():
     the height the parabola z0 + v t - g t^2 / 2 at each frame time, although the frames (every
     7 ms) fall between steps. The leapfrog path is off its parabola by at most g dt^2 / 8 between
     steps; a frame taken at the nearest step instead would be off by up to |v| dt / 2 in height
-    and omega dt / 2 in angle. (rockdem takes the initial velocity as that of the half step before
-    t = 0, so the parabola's v(0) is v0 - g dt / 2.)"""
+    and omega dt / 2 in angle. The parabola's v(0) is the given 3 m/s: the first velocity update
+    spans half a step (until 2026-11-29 it took the initial velocity as that of the half step
+    before t = 0, and the parabola's v(0) was v0 - g dt / 2)."""
     b = ModelBuilder()
     b.default_material = JointMaterial.from_modulus(1.8e9, 0.4)
     b.add_box(1.0, 1.0, 0.1, base_center=(0, 0, -5.0), driven=True, name="far ground")
@@ -130,7 +131,7 @@ def test_frames_between_steps_follow_free_flight_exactly():
     assert 0.007 / dt % 1.0 > 0.05  # the frames do fall between steps
     k = int(np.flatnonzero(ds.block_free.values)[0])
     z = ds.block_position.values[:, k, 2]
-    v_start = 3.0 - 0.5 * 9.81 * dt
+    v_start = 3.0
     exact = 1.0 + v_start * t - 0.5 * 9.81 * t * t
     assert np.max(np.abs(z - exact)) <= 9.81 * dt * dt / 8 + 1e-12
     assert np.max(np.abs(z - exact)) < 0.01 * 3.0 * 0.5 * dt  # far below the nearest-step error

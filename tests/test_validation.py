@@ -449,3 +449,23 @@ def test_a_block_falling_past_the_trailing_edge_of_a_displaced_foundation_falls_
     trailing_edge = float(ds.block_position.sel(block="foundation").values[k, 0]) + 0.5
     # Where it left the extent: within the foundation's plan at the start, past it where it is now.
     assert m.arrays.support_low[0] <= x <= m.arrays.support_high[0] and trailing_edge < x
+
+
+def test_a_block_beside_a_foundation_that_moves_back_under_it_has_fallen_off_not_through():
+    """A cube set beside a 4 m foundation falls past its edge; the foundation then moves 0.5 m
+    towards it (1 m/s from 0.5 to 1 s) and covers the cube's plan by the time the cube leaves the
+    model's extent, 4.5 m below. The cube left the supports when its centroid passed below them
+    beside their plan (0.15 + 0.5 m = g t^2 / 2 at 0.364 s): the run completes and names it.
+    Before 2026-11-29 it stopped as "lost" (fell through its support) at 1.016 s."""
+    from rockdem.model import Motion
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=1e10, friction_angle=35)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=Motion.constant((1.0, 0, 0), start=0.5, stop=1.0), name="ground")
+    b.add_box(0.2, 0.2, 0.2, base_center=(2.3, 0, 0.05), density=2000, name="cube")
+    m = b.finalize(damping=Damping(beta=1e-4))
+    ds, t_off, _ = _run_until_the_cube_falls_off(m, 1.5)
+    assert t_off == pytest.approx(math.sqrt(2 * 0.65 / 9.81), abs=0.003)  # the first frame below the foundation
+    x, z = ds.block_position.sel(block="cube").values[-1, [0, 2]]
+    edge = float(ds.block_position.sel(block="ground").values[-1, 0]) + 2.0
+    assert x < edge and z < m.arrays.extent_low[2]  # under the foundation's plan now, below the extent

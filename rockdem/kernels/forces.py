@@ -780,7 +780,7 @@ def _law_range(
             # Implicit dashpots (kernels.implicit): half the force at the last half step's velocity
             # now, the other half at the new velocity in the velocity solve. A contact that closed
             # during the last step has its dashpot from the crossing on.
-            onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
+            onset = dashpot_onset_share(since, s.velocity_lag[0] + 0.5 * s.dt[0]) if closing else 1.0
             sc.dashpot_cn[k] = onset * beta * kna
             sc.dashpot_cs[k] = onset * bs
             sc.dashpot_normal[k, 0] = n0
@@ -1033,7 +1033,7 @@ def _edge_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float) -> tupl
     fdn = -beta * kna * vn
     bs = 0.0 if slipping else beta * ksa
     if s.dashpots[0] == DASHPOTS_IMPLICIT and beta > 0.0:  # as in _law_range
-        onset = dashpot_onset_share(since, 0.5 * (s.dt_prev[0] + s.dt[0])) if closing else 1.0
+        onset = dashpot_onset_share(since, s.velocity_lag[0] + 0.5 * s.dt[0]) if closing else 1.0
         sc.pair_dashpot_cn[i] = onset * beta * kna
         sc.pair_dashpot_cs[i] = onset * bs
         sc.pair_dashpot_velocity[i, 0] = v0

@@ -151,6 +151,8 @@ class State(NamedTuple):
     time: np.ndarray  # (1,) [s]
     dt: np.ndarray  # (1,) [s] step to take next
     dt_prev: np.ndarray  # (1,) [s] step just taken
+    velocity_lag: np.ndarray  # (1,) [s] how long before ``time`` the velocities hold: half the step just
+    # taken (leapfrog), 0 at a fresh start (the initial velocities are those at t = 0)
     dt_min: np.ndarray  # (1,) [s] smallest step used so far
     safety: np.ndarray  # (1,) fraction of the stable bound used when the step is lowered
     resolution: np.ndarray  # (1,) largest omega_max dt / 2 when the step is lowered (impact resolution)
@@ -161,7 +163,7 @@ class State(NamedTuple):
     slot_updates: np.ndarray  # (1,) int64 tracked sub-contacts summed over the steps taken (work done)
     position: np.ndarray  # (nb, 3) [m] centroid
     quaternion: np.ndarray  # (nb, 4) body -> world
-    velocity: np.ndarray  # (nb, 3) [m/s] at the last half step
+    velocity: np.ndarray  # (nb, 3) [m/s] at time - velocity_lag (the last half step)
     omega: np.ndarray  # (nb, 3) [rad/s] body frame, last half step
     slot_partner: np.ndarray  # (np, SLOTS) int64 partner block, -1 none
     slot_face: np.ndarray  # (np, SLOTS) int64 target face

@@ -134,9 +134,10 @@ def integrate_velocities(
     m: ModelArrays, s: State, sc: Scratch, t: float, dt: float, rec: Records, frame: int, frame_end: int,
     step: float, interval: float,
 ) -> None:
-    """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` [s] (the mean of the last and the next
-    step); records frames ``frame`` to ``frame_end`` - 1 (none if equal), frame k at its time
-    k ``interval`` [s] within half a step of t_n (several when the step exceeds the interval).
+    """v_{n-1/2} -> v_{n+1/2} for every block over ``dt`` [s] (``State.velocity_lag`` plus half the
+    next step: the mean of the last and the next step, half the next at a fresh start); records
+    frames ``frame`` to ``frame_end`` - 1 (none if equal), frame k at its time k ``interval`` [s]
+    within half a step of t_n (several when the step exceeds the interval).
 
     Driven blocks first take their prescribed velocity at the middle of the next position step
     ``step`` [s]. A free block with an active
@@ -168,7 +169,7 @@ def integrate_velocities(
             s.omega[b, i] = 0.0
             sc.velocity_mid[b, i] = vd[i]
             sc.omega_mid[b, i] = 0.0
-    # The velocity at t_n: the half-step velocities at t_n - dt_prev / 2 and t_n + step / 2
+    # The velocity at t_n: the velocities at t_n - velocity_lag and t_n + step / 2
     # interpolated (their mean when the two steps are equal; dt is their mean).
     w_new = 1.0 - 0.5 * step / dt
     w_old = 1.0 - w_new
@@ -434,6 +435,20 @@ def _under_a_support(m: ModelArrays, s: State, sc: Scratch, x: float, y: float) 
 
 
 @njit(cache=True, _nrt=False)
+def _support_bottom(m: ModelArrays, s: State, sc: Scratch) -> float:
+    """Height [m] of the lowest vertex of the driven blocks now (-inf without driven blocks)."""
+    bottom = np.inf
+    for b in range(m.block_mass.shape[0]):
+        if m.block_free[b]:
+            continue
+        r = sc.rotation[b]
+        for v in range(m.block_vertex_start[b], m.block_vertex_start[b + 1]):
+            p = m.vertex_local[v]
+            bottom = min(bottom, s.position[b, 2] + r[2, 0] * p[0] + r[2, 1] * p[1] + r[2, 2] * p[2])
+    return bottom if bottom < np.inf else -np.inf
+
+
+@njit(cache=True, _nrt=False)
 def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int) -> int:
     """Status of recorded frame ``frame``: STATUS_DIVERGED when the state is not finite or energy
     was created: the mechanical energy (kinetic + potential + elastic) exceeds its initial value
@@ -445,8 +460,10 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     ``sc.lost_block`` names the block (-1 for an energy divergence). A block leaving the extent
     through its bottom beside the driven blocks' current plans, or through a side (thrown clear of the
     supports, it is falling), has left the supports: its time is noted in ``s.fell_off`` and it
-    falls on unhindered, no longer checked. (A dissipation term booked in excess shows in the
-    recorded balance error but is not a divergence.)"""
+    falls on unhindered, no longer checked. So has one whose centroid is below every driven block
+    and beside their current plans, as soon as it is: a support that moves back over its plan later
+    (a ground motion) must not read as one it fell through. (A dissipation term booked in excess
+    shows in the recorded balance error but is not a divergence.)"""
     e = rec.energy[frame]
     e0 = rec.energy[0]
     scale = 0.0
@@ -468,6 +485,7 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
     lx, hx = _driven_shift(m, s, rec, 0)
     ly, hy = _driven_shift(m, s, rec, 1)
     lz, hz = _driven_shift(m, s, rec, 2)
+    bottom = _support_bottom(m, s, sc)
     for b in range(m.block_mass.shape[0]):
         if not m.block_free[b] or s.fell_off[b] >= 0.0:
             continue
@@ -475,6 +493,9 @@ def check_frame(m: ModelArrays, s: State, sc: Scratch, rec: Records, frame: int)
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
             sc.lost_block[0] = b
             return STATUS_DIVERGED
+        if z < bottom and not _under_a_support(m, s, sc, x, y):  # below and beside the supports: it left them
+            s.fell_off[b] = rec.time[frame]
+            continue
         high = z > m.extent_high[2] + hz
         outside = (high or z < m.extent_low[2] + lz or x < m.extent_low[0] + lx or x > m.extent_high[0] + hx
                    or y < m.extent_low[1] + ly or y > m.extent_high[1] + hy)
@@ -547,15 +568,19 @@ def advance(
         end = frame
         while end < rec.time.shape[0] and end * record_interval <= t + 0.5 * dt:
             end += 1
-        h = 0.5 * (s.dt_prev[0] + dt)
-        # Body loads at the middle of this velocity update's interval [t - dt_prev/2, t + dt/2]
-        # (t itself unless the step was just lowered).
-        compute_forces(m, s, sc, t + 0.25 * (dt - s.dt_prev[0]), s.dt_prev[0])
+        # The velocity update's interval [t - lag, t + dt/2]: lag = dt_prev / 2 (the leapfrog's
+        # half-step velocities), 0 at a fresh start, whose velocities are those at t = 0 (so the
+        # first update is v0 + a dt / 2: with dt, every trajectory from rest ran half a step early).
+        lag = s.velocity_lag[0]
+        h = lag + 0.5 * dt
+        # Body loads at the middle of that interval (t itself unless the step was just lowered).
+        compute_forces(m, s, sc, t + 0.5 * (0.5 * dt - lag), s.dt_prev[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT and has_dashpots(m):
             dashpot_work(m, s, sc, h)
         integrate_positions(m, s, dt)
         s.dt_prev[0] = dt
+        s.velocity_lag[0] = 0.5 * dt
         s.time[0] = t + dt
         s.step[0] += 1
         s.slot_updates[0] += s.track_count[0]
