@@ -18,7 +18,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -41,6 +41,7 @@ __all__ = [
     "first_impact_time",
     "rocking_onset_time",
     "summarize",
+    "free_rocking_run",
     "lowest_point_height",
     "lowest_vertex_height",
     "result_eta",
@@ -229,6 +230,8 @@ def apparent_restitution(peaks: ArrayLike, theta0: float, eta: float, *, exact: 
     if not (0.0 < th0 < eta):
         raise ValueError(f"theta0 must lie in (0, eta = {eta:.6g}) rad, got {theta0!r} (a release beyond eta overturns)")
     p = np.abs(np.asarray(peaks, dtype=float)).ravel()
+    if not np.all(np.isfinite(p)):
+        raise ValueError("apparent_restitution: peaks must be finite rotations [rad] (remove NaN/inf)")
     if np.any(p > eta):
         warn_user("apparent_restitution: some peaks exceed eta (overturning?); Eq. 6 is not defined there")
     n = np.arange(1, len(p) + 1)
@@ -400,6 +403,8 @@ def max_rotation(theta: ArrayLike) -> float:
     th = np.asarray(theta, dtype=float)
     if th.size == 0:
         raise ValueError("max_rotation: empty history")
+    if not np.all(np.isfinite(th)):
+        raise ValueError("max_rotation: the history must be finite (remove NaN/inf samples)")
     return float(np.max(np.abs(th)))
 
 
@@ -426,6 +431,10 @@ def overturned(theta: ArrayLike, eta: float, *, rtol: float = 1e-9) -> bool:
     if not (0.0 < eta < 0.5 * np.pi):
         raise ValueError(f"eta must be the slenderness angle in (0, pi/2) rad, got {eta!r}")
     th = np.asarray(theta, dtype=float)
+    if th.size == 0:
+        raise ValueError("overturned: empty history")
+    if not np.all(np.isfinite(th)):
+        raise ValueError("overturned: the history must be finite (remove NaN/inf samples)")
     return bool(abs(th[-1]) >= eta * (1.0 - rtol))
 
 
@@ -514,8 +523,8 @@ def summarize(
     out["half_cycles"] = int(len(pk.value)) if out["onset_time_s"] is not None else 0  # vibration below the onset is not rocking
     if eta is not None:
         out["eta_rad"] = float(eta)
-        out["exceeded_eta"] = bool(max_rotation(th) > eta)
         out["overturned"] = overturned(th, eta)
+        out["exceeded_eta"] = bool(max_rotation(th) > eta) or out["overturned"]  # one that ends at eta reached it
         th0 = abs(float(pk.value[0])) if len(pk.value) else 0.0
         if free_rocking and out["onset_time_s"] is not None and len(pk.value) >= 2 and 0.0 < th0 < eta:
             with warnings.catch_warnings():
@@ -654,14 +663,23 @@ def is_pushover(ds: Any) -> bool:
     return "load_factor" in ds or any(str(k).startswith("pushover_") for k in ds.attrs)
 
 
-def is_free_rocking(ds: Any) -> bool:
-    """Whether a result is a free-rocking run: released from a tilt (attrs ``tilt_angle_rad`` or a
-    non-zero rocking angle at t = 0), with no earthquake and no pushover."""
-    moved = "ground_displacement" in ds and bool(np.any(ds.ground_displacement.values != 0.0))
-    if is_pushover(ds) or "earthquake_mode" in ds.attrs or moved:
+def free_rocking_run(attrs: Mapping[str, Any], *, released: bool, ground_moved: bool = False) -> bool:
+    """Whether a run with result attributes ``attrs`` is free rocking: released from a tilt (attrs
+    ``tilt_angle_rad``, or ``released``: a free block's rocking angle is not zero at t = 0), with no
+    earthquake (attrs ``earthquake_mode``, or ``ground_moved``) and no pushover (attrs
+    ``pushover_*``). Only then is e_a (paper Eq. 6) a restitution."""
+    if any(str(k).startswith("pushover_") for k in attrs) or "earthquake_mode" in attrs or ground_moved:
         return False
+    return "tilt_angle_rad" in attrs or released
+
+
+def is_free_rocking(ds: Any) -> bool:
+    """Whether a result is a free-rocking run (:func:`free_rocking_run`)."""
+    if "load_factor" in ds:
+        return False
+    moved = "ground_displacement" in ds and bool(np.any(ds.ground_displacement.values != 0.0))
     free = np.flatnonzero(ds.block_free.values)
-    return "tilt_angle_rad" in ds.attrs or bool(np.any(ds.rocking_angle.values[0, free] != 0.0))
+    return free_rocking_run(ds.attrs, released=bool(np.any(ds.rocking_angle.values[0, free] != 0.0)), ground_moved=moved)
 
 
 def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = None) -> dict[str, Any]:

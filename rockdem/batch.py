@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .analysis import block_thickness_of, eta_of, fallen, lowest_vertex_height, summarize
+from .analysis import block_thickness_of, eta_of, fallen, free_rocking_run, lowest_vertex_height, summarize
 from .case import Case, CaseTemplate, template_key
 from .kernels.layout import COUNT_FAILED_SHEAR, COUNT_FAILED_TENSION, E_POTENTIAL, ENERGY_NAMES
 from .results import block_eta, damping_attrs, energy_check, ground_displacement, monitor_displacements, reference_rotations, rocking_angles
@@ -149,7 +149,10 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     z = lowest_vertex_height(f.position[:, b], f.quaternion[:, b], f.vertex_local[starts[b] : starts[b + 1]])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        s = summarize(t, theta, eta=eta_used, z=z)
+        # e_a (paper Eq. 6) only for free rocking, as rockdem run's summary (an earthquake's read 1.01 to 1.18)
+        free_rocking = free_rocking_run(a, released=bool(np.any(f.rocking[0, free] != 0.0)),
+                                        ground_moved=bool(np.any(f.ground_end != 0.0)))
+        s = summarize(t, theta, eta=eta_used, z=z, free_rocking=free_rocking)
     npts = max(int(a.get("point_count", 1)), 1)
     row: dict[str, Any] = {"id": spec.id, **spec.inputs, "status": "diverged" if a.get("diverged") else "ok"}
     if a.get("diverged"):

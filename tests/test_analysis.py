@@ -383,3 +383,24 @@ def test_no_restitution_is_reported_without_rocking() -> None:
     t = np.linspace(0.0, 2.0, 4001)
     s = summarize(t, 1e-4 * np.exp(-t) * np.abs(np.cos(2 * np.pi * 2 * t)), eta=0.2)  # peaks below 1 % of eta
     assert s["onset_time_s"] is None and "e_a_mean" not in s and s["half_cycles"] == 0
+
+
+def test_non_finite_or_empty_histories_are_refused_by_every_measure():
+    """max_rotation, overturned and apparent_restitution refuse NaN (and overturned an empty
+    history) as half_cycle_peaks, wme and bouncing do, instead of answering nan or False (before
+    2026-11-29 a history ending in NaN read as not overturned)."""
+    from rockdem.analysis import apparent_restitution, max_rotation, overturned
+
+    th = np.append(np.sin(np.linspace(0.0, 3.0, 50)) * 0.1, np.nan)
+    for call in (lambda: max_rotation(th), lambda: overturned(th, 0.2), lambda: overturned([], 0.2),
+                 lambda: apparent_restitution([0.05, np.nan], 0.1, 0.2)):
+        with pytest.raises(ValueError, match="finite|empty"):
+            call()
+
+
+def test_a_history_ending_at_eta_has_exceeded_it():
+    # Overturned (it ends at eta, within rtol) and not "exceeded eta" was a contradiction.
+    t = np.linspace(0.0, 1.0, 101)
+    eta = 0.2
+    s = summarize(t, eta * t, eta=eta)
+    assert s["overturned"] and s["exceeded_eta"]

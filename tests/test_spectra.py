@@ -25,14 +25,19 @@ def sdof_psa(motion: GroundMotion, period: float, zeta: float) -> float:
     return w * w * float(np.max(np.abs(u)))
 
 
-def test_spectrum_matches_a_time_domain_oscillator():
-    gm = read_record("elcentro-rsn6")
-    periods = np.array([0.1, 0.3, 0.5, 1.0, 2.0])
+@pytest.mark.parametrize("name", ["elcentro-rsn6", "nahanni", "elcentro-peknold"])
+def test_spectrum_matches_a_time_domain_oscillator(name):
+    """Up to the long periods of slender rocking blocks (their rocking periods are 2 s and more):
+    before 2026-11-29 the record was not padded, pyrotd's frequency-domain oscillators wrapped their
+    free vibration round onto the record's start, and PSA was 20 to 25 % off at T = 2 to 5 s
+    (Nahanni +25 % at 5 s, Peknold's El Centro -20 % at 4 s)."""
+    gm = read_record(name)
+    periods = np.array([0.3, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0])
     spec = response_spectrum(gm, periods, damping=0.05)
     ref = np.array([sdof_psa(gm, t, 0.05) for t in periods])
     np.testing.assert_allclose(spec.psa, ref, rtol=0.03)
-    # a rigid oscillator follows the ground: PSA(T -> 0) = PGA
-    assert response_spectrum(gm, [0.01]).psa[0] == pytest.approx(gm.pga, rel=0.02)
+    if name == "elcentro-rsn6":  # a rigid oscillator follows the ground: PSA(T -> 0) = PGA (a finely sampled record)
+        assert response_spectrum(gm, [0.01]).psa[0] == pytest.approx(gm.pga, rel=0.02)
     np.testing.assert_allclose(spec.sd, spec.psa / (2 * np.pi / periods) ** 2)
 
 
