@@ -44,6 +44,7 @@ import numpy as np
 from ._warn import warn_user
 from .beta_choice import BetaChoice, RestitutionTarget
 from .kernels.contact import sp_critical_factor
+from .materials import HEAVIEST_DENSITY, PLAUSIBLE_DENSITY, STIFFEST_MODULUS
 
 if TYPE_CHECKING:
     from .model import ModelBuilder
@@ -147,6 +148,16 @@ class AdviceInput:
             raise ValueError(
                 f"youngs_modulus = {self.youngs_modulus!r} Pa is below 1 MPa: E is in Pa "
                 "(1800 MPa = 1.8e9 Pa; on the command line use --youngs-modulus-mpa for MPa)"
+            )
+        if self.youngs_modulus > STIFFEST_MODULUS:
+            raise ValueError(
+                f"youngs_modulus = {self.youngs_modulus:g} Pa is stiffer than any material (steel 2e11 Pa, masonry "
+                "1e9 to 2e10 Pa): E is in Pa (on the command line --youngs-modulus-mpa takes MPa: 1800, not 1.8e9)"
+            )
+        if not PLAUSIBLE_DENSITY <= self.density <= HEAVIEST_DENSITY:
+            raise ValueError(
+                f"density = {self.density:g} kg/m^3 is outside the range of building materials ({PLAUSIBLE_DENSITY:g} "
+                f"to {HEAVIEST_DENSITY:g} kg/m^3; masonry 1500 to 2500): density is in kg/m^3 (1.8 t/m^3 is 1800)"
             )
 
 

@@ -31,9 +31,9 @@ from matplotlib import colormaps, rc_context
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .cli import integer_at_least, positive_float, positive_int
+from .cli import integer_at_least, output_file, positive_float, positive_int
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices, rotation_vector
-from .plots import STYLE, Result, load_result, rocking_direction
+from .plots import STYLE, Result, load_result, read_result_file, rocking_direction
 
 __all__ = ["VIEWS", "MIN_FPS", "ANIMATION_STYLE", "Playback", "playback", "frame_indices", "posed_vertices",
            "render_frames", "animate", "register_cli"]
@@ -402,18 +402,32 @@ def _view_arg(text: str) -> str | tuple[float, float]:
     try:
         elev, azim = (float(v) for v in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"--view: one of {sorted(VIEWS)} or ELEV,AZIM in degrees") from None
+        elev = azim = math.nan
+    if not (math.isfinite(elev) and math.isfinite(azim) and abs(elev) <= 90.0 and abs(azim) <= 360.0):
+        raise argparse.ArgumentTypeError(f"--view: one of {sorted(VIEWS)} or ELEV,AZIM in degrees (|ELEV| <= 90, "
+                                         f"|AZIM| <= 360), got {text!r}")
     return elev, azim
 
 
-def _animate(args: argparse.Namespace) -> int:
-    from .vtk_export import read_result_file
+MAX_FRAME_PIXELS = 4096
+"""Largest width or height of an animation frame [pixels] (4K video is 3840 x 2160)."""
 
+
+def _frame_size(text: str) -> int:
+    """--size W H: each between 16 and MAX_FRAME_PIXELS pixels."""
+    v = integer_at_least(16)(text)
+    if v > MAX_FRAME_PIXELS:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_FRAME_PIXELS} pixels, got {text!r}")
+    return v
+
+
+def _animate(args: argparse.Namespace) -> int:
     out = Path(args.output) if args.output else Path(args.result).with_suffix(".gif")
     if out.is_dir():
         raise ValueError(f"-o {out} is a folder; give the animation file (.gif or .mp4)")
     if out.suffix.lower() not in (".gif", ".mp4"):
         raise ValueError(f"-o {out}: the suffix must be .gif or .mp4")
+    output_file(out, "-o")
     w, h = args.size
     ds = read_result_file(args.result)
     p = animate(
@@ -444,6 +458,6 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--speed", type=positive_float, default=1.0, help="simulated seconds per playback second (default 1)")
     p.add_argument("--max-frames", type=positive_int, default=300,
                    help=f"most frames (default 300): beyond, the rate drops to {MIN_FPS:g} fps, then the playback speeds up (said)")
-    p.add_argument("--size", type=integer_at_least(16), nargs=2, default=(640, 480), metavar=("W", "H"), help="pixels (default 640 480)")
+    p.add_argument("--size", type=_frame_size, nargs=2, default=(640, 480), metavar=("W", "H"), help="pixels (default 640 480)")
     p.add_argument("--dpi", type=positive_float, default=100.0, help="pixels per inch of the text (default 100)")
     p.set_defaults(func=_animate)

@@ -67,17 +67,19 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
     if quantity not in QUANTITIES:
         raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
     if p.suffix == ".nc":
-        from .results import load
+        from .plots import read_result_file
 
-        try:
-            ds = load(p)
-        except (OSError, ValueError) as exc:
-            raise ValueError(f"reference {p}: not a rockdem result ({exc})") from None
+        ds = read_result_file(p, "reference")
         t = np.asarray(ds.time.values, dtype=float)
         if quantity == "rotation":
-            b = int(np.flatnonzero(ds.block_free.values)[0])
-            x = np.asarray(ds.rocking_angle.values[:, b], dtype=float)
+            free = np.flatnonzero(ds.block_free.values)
+            if free.size == 0:
+                raise ValueError(f"reference {p}: the result has no free block whose rotation to match")
+            x = np.asarray(ds.rocking_angle.values[:, int(free[0])], dtype=float)
         else:
+            if ds.sizes.get("monitor", 0) == 0:
+                raise ValueError(f"reference {p}: the result has no monitor; use --quantity rotation or a result "
+                                 "with a monitor")
             x = np.asarray(ds.monitor_displacement.values[:, 0, 0], dtype=float)
         return Reference(t, x, quantity)
     need = (f"need rows of time [s] and value (column {column}, zero-based), separated by commas or spaces, or by "
@@ -365,16 +367,14 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
 
 
 def _calibrate_cli(args: argparse.Namespace) -> int:
-    from .cli import stop_on_signals
+    from .cli import output_folder, stop_on_signals
 
     ref = load_reference(args.reference, quantity=args.quantity)
     fixed = dict(parse_assignment(item) for item in args.set or [])
     if not args.linear and min(args.bounds) <= 0:
         raise ValueError(f"--bounds {args.bounds[0]:g} {args.bounds[1]:g}: the search is in log(parameter) and needs "
                          "positive bounds; add --linear for a parameter that may be 0")
-    out = Path(args.out) if args.out else None
-    if out is not None and out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out} is an existing file; give a folder")
+    out = output_folder(args.out, "--out", create=False) if args.out else None
     store = Store(out) if out is not None else None  # finished runs kept: a rerun resumes
     try:
         with stop_on_signals():  # SIGTERM and SIGHUP stop it as Ctrl-C does

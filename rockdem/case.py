@@ -26,7 +26,7 @@ import numpy as np
 
 from ._warn import warn_user
 from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
-from .geometry import MAX_FACE_POINTS
+from .geometry import MAX_FACE_POINTS, MAX_LENGTH
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
@@ -344,7 +344,13 @@ def _block(t: Table, b: ModelBuilder) -> dict[str, Monitor]:
     if extent is not None and extent < max(width, length):
         raise ValueError(f"[{t.where}] foundation_extent = {extent:g} m is smaller than the block's footprint "
                          f"({width:g} x {length:g} m); give at least {max(width, length):g} m")
+    for key, v in (("width", width), ("height", height), ("length", length), ("foundation_extent", extent)):
+        if v is not None and v > MAX_LENGTH:
+            raise ValueError(f"[{t.where}] {key} = {v:g} m is beyond any structure (at most {MAX_LENGTH:g} m); lengths are in metres")
     size = 2.0 * max(width, length, height) if extent is None else extent
+    if size > MAX_LENGTH:
+        raise ValueError(f"[{t.where}] the foundation, twice the block's largest dimension ({size:g} m), exceeds {MAX_LENGTH:g} m: "
+                         "check the block's dimensions (in metres) or give foundation_extent")
     b.add_box(size, size, 0.25 * size, base_center=(0.0, 0.0, -0.25 * size), driven="ground", group="foundation", name="foundation", points=(2, 2))
     b.add_box(width, length, height, density=density, name="block", points=pts)
     return {"top": ("block", (0.5 * width, 0.0, height))}

@@ -34,6 +34,7 @@ import hashlib
 import json
 import os
 import tempfile
+import zipfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -225,13 +226,15 @@ class Checkpoint:
                 whose engine state has other fields.
         """
         p = Path(path)
+        if p.is_dir():
+            raise ValueError(f"checkpoint {p} is a folder; give the checkpoint.npz that rockdem run writes in its output folder")
         if not p.is_file():
             raise FileNotFoundError(f"checkpoint {p} does not exist (rockdem run writes OUT/checkpoint.npz)")
         try:
             with np.load(p, allow_pickle=False) as z:
                 data = {k: z[k] for k in z.files}
             meta = json.loads(str(data.pop("meta")))
-        except (OSError, ValueError, KeyError) as exc:
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:  # truncated or empty files too
             raise ValueError(f"{p} is not a rockdem checkpoint (.npz written by rockdem run or simulate): {exc}") from None
         if meta.get("format") != FORMAT:
             raise ValueError(f"{p} is not a rockdem checkpoint (format {meta.get('format')!r})")

@@ -14,9 +14,11 @@ import importlib
 import math
 import signal
 import sys
+import tempfile
 import threading
 import warnings
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 # The module that contributes each sub-command through ``register_cli(subparsers)``: a command line
 # naming a command imports only its module (``rockdem run`` does not load Matplotlib or SciPy's
@@ -150,6 +152,42 @@ def integer_at_least(low: int) -> Callable[[str], int]:
     return parse
 
 
+def output_folder(path: str | Path, what: str, files: tuple[str, ...] = (), *, create: bool = True) -> Path:
+    """Check an output folder before any work: it must be (or, with ``create`` False, its nearest
+    existing parent must be) a writable folder, and none of ``files`` in it may be a folder.
+    ``create``: make it now (else the command makes it when it writes). ``what`` names it in
+    messages (a flag or a key). Raises ValueError."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{what} {path} is an existing file; give a folder for the results")
+    probe = path
+    while not create and not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    try:
+        if create:
+            path.mkdir(parents=True, exist_ok=True)
+        elif not probe.is_dir():
+            raise NotADirectoryError(20, f"{probe} is a file", str(probe))
+        with tempfile.TemporaryFile(dir=probe):
+            pass
+    except OSError as exc:
+        raise ValueError(f"{what} {path}: cannot write there ({exc.strerror or exc}); choose a writable folder") from None
+    for name in files:
+        if (path / name).is_dir():
+            raise ValueError(f"{what} {path}: {name} is a folder; remove it or choose another output folder")
+    return path
+
+
+def output_file(path: str | Path, what: str) -> Path:
+    """Check before any work that the file ``path`` can be written (its folder is created if
+    needed): not a folder, in a writable folder. ``what`` names it in messages. Raises ValueError."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{what} {path} is a folder; give a file name")
+    output_folder(path.parent, f"{what} {path}: the folder")
+    return path
+
+
 positive_float = _number("positive")
 non_negative_float = _number("non-negative")
 positive_int = integer_at_least(1)
@@ -233,6 +271,11 @@ def _main(argv: list[str] | None) -> int:
             return int(args.func(args) or 0)
     except (ValueError, FileNotFoundError) as exc:
         print(f"rockdem {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except OSError as exc:  # a file or folder the command could not read or write
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"rockdem {args.command}: error: {where}{exc.strerror or exc}; check the path and its permissions",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt as exc:
         name = signal.Signals(exit_status(exc) - 128).name

@@ -604,7 +604,9 @@ def _fragility_cli(args: argparse.Namespace) -> int:
         raise ValueError(f"--pga LOW HIGH N: give 0 < LOW <= HIGH [g] and N >= 1 levels (N = 1 with LOW = HIGH), "
                          f"got {' '.join(args.pga)}")
     levels = np.linspace(lo, hi, n)
-    from .cli import stop_on_signals
+    from .cli import output_folder, stop_on_signals
+
+    output_folder(args.out, "--out", create=False)
 
     try:
         with stop_on_signals():  # SIGTERM and SIGHUP stop it and its workers as Ctrl-C does

@@ -44,6 +44,7 @@ import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike, NDArray
 
+from ._warn import warn_user
 from .case import Table, loading
 from .geometry import box, mass_properties
 from .analysis import fallen_blocks
@@ -131,6 +132,9 @@ def prepare_record(
         if keep.sum() < 2:
             raise ValueError(f"{gm.name}: window ({t0:g}, {t1:g}) holds fewer than two samples "
                              f"(record spans {gm.time[0]:g}..{gm.time[-1]:g} s)")
+        if t0 < gm.time[0] - 0.5 * gm.dt or t1 > gm.time[-1] + 0.5 * gm.dt:
+            warn_user(f"{gm.name}: window ({t0:g}, {t1:g}) s reaches beyond the record ({gm.time[0]:g}..{gm.time[-1]:g} s): "
+                      f"only {float(gm.time[keep][0]):g}..{float(gm.time[keep][-1]):g} s is used")
         vert = None if gm.vertical is None else gm.vertical[keep]
         gm = replace(gm, acceleration=gm.acceleration[keep], vertical=vert, start_time=float(gm.time[keep][0]))
     if not vertical and gm.vertical is not None:
@@ -642,7 +646,14 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
 
 
 def _read_table_record(t: Table, key: str, units: str | None, dt: float | None, columns: tuple[int | None, int | None]) -> GroundMotion:
-    return _read_cached(str(record_path(t.string(key))), units, dt, columns)
+    """The record file of key ``key`` of a loading table, read with the table's units, dt and columns;
+    a file that cannot be read is refused with the table's keys that tell how to read it."""
+    name = t.string(key)
+    try:
+        return _read_cached(str(record_path(name)), units, dt, columns)
+    except ValueError as exc:
+        raise ValueError(f"[{t.where}] {key} = {name!r}: {exc} (in the case file: [{t.where}] units = \"g\", \"m/s2\" or "
+                         "\"cm/s2\"; dt = the time step [s]; time_column, acc_column = zero-based columns)") from None
 
 
 def _read_cached(path: str, units: str | None, dt: float | None, columns: tuple[int | None, int | None] = (None, None)) -> GroundMotion:

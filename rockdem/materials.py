@@ -7,6 +7,13 @@ import numbers
 from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
+#: Outside these, a value is almost surely in the wrong unit (masonry: 1500-2500 kg/m^3, E 1-20 GPa).
+PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
+HEAVIEST_DENSITY = 12_000.0  # [kg/m^3] heavier than lead
+PLAUSIBLE_MODULUS = 1e6  # [Pa]
+STIFFEST_MODULUS = 1e12  # [Pa] stiffer than any material (diamond about 1.1e12)
+PLAUSIBLE_FRICTION_ANGLE = 3.0  # [deg] below this a friction angle is likely a coefficient mu
+
 __all__ = ["JointMaterial", "check_material", "kn_from_modulus", "ks_from_kn", "real_number"]
 
 

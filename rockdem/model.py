@@ -20,7 +20,8 @@ from .flatten import BlockFrame, flatten_geometry
 from .geometry import MAX_FACE_POINTS, Polyhedron, box, mass_properties
 from .kernels.layout import ModelArrays
 from .kernels.rotation import axis_angle_matrix, matrix_to_quat
-from .materials import JointMaterial, real_number
+from .materials import (HEAVIEST_DENSITY, PLAUSIBLE_DENSITY, PLAUSIBLE_FRICTION_ANGLE, PLAUSIBLE_MODULUS, JointMaterial,
+                        real_number)
 
 __all__ = ["Motion", "Damping", "ModelBuilder", "Model", "GROUND"]
 
@@ -960,11 +961,6 @@ def _vector3(value: ArrayLike, what: str) -> NDArray[np.float64]:
     return v
 
 
-#: Below these, a value is almost surely in the wrong unit (masonry: 1500-2500 kg/m^3, E >= 1 MPa).
-PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
-HEAVIEST_DENSITY = 12_000.0  # [kg/m^3] heavier than lead
-PLAUSIBLE_MODULUS = 1e6  # [Pa]
-PLAUSIBLE_FRICTION_ANGLE = 3.0  # [deg] below this a friction angle is likely a coefficient mu
 
 
 OVERDAMPED_BETA = 10.0

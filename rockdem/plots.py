@@ -20,6 +20,7 @@ The CLI is ``rockdem plot RESULT.nc [MORE.nc ...] --kind KIND -o OUT.png|pdf``.
 from __future__ import annotations
 
 import argparse
+import csv
 import functools
 from pathlib import Path
 from typing import Callable, Sequence
@@ -119,6 +120,31 @@ def load_result(result: Result) -> xr.Dataset:
     from .results import load
 
     return load(result)
+
+
+RESULT_VARIABLES = ("block_free", "block_name", "block_position", "rocking_angle")
+"""Variables every result of rockdem run or simulate holds (the commands check for them)."""
+
+
+def read_result_file(path: str | Path, what: str = "result file") -> xr.Dataset:
+    """A rockdem result read from ``path`` for a command: FileNotFoundError or ValueError naming the
+    file (as ``what``) when it is missing, not a regular file, not a result or holds no frame."""
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{what} {p} does not exist (rockdem run writes OUT/result.nc)")
+    if not p.is_file():
+        raise ValueError(f"{what} {p} is not a regular file; give the result.nc written by rockdem run")
+    try:
+        ds = load_result(p)
+    except (ValueError, OSError, KeyError) as exc:
+        raise ValueError(f"{what} {p} is not a rockdem result (the NetCDF file written by rockdem run): "
+                         f"{str(exc)[:200]}") from None
+    missing = [v for v in RESULT_VARIABLES if v not in ds]
+    if missing or "time" not in ds.coords:
+        raise ValueError(f"{what} {p} is not a rockdem result: it has no {', '.join(missing or ['time'])}")
+    if ds.sizes["time"] == 0:
+        raise ValueError(f"{what} {p} holds no recorded frame; rerun the case")
+    return ds
 
 
 def _label(ds: xr.Dataset, fallback: str) -> str:
@@ -507,7 +533,12 @@ def read_history_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"measured history {p} does not exist")
-    df = pd.read_csv(p, sep=None, engine="python", comment="#", header=None)
+    if not p.is_file():
+        raise ValueError(f"measured history {p} is not a file; give a CSV or text file of time [s] and value")
+    try:
+        df = pd.read_csv(p, sep=None, engine="python", comment="#", header=None)
+    except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError, csv.Error) as exc:
+        raise ValueError(f"measured history {p} is not a text table of time [s] and value: {str(exc)[:120]}") from None
     df = df.apply(pd.to_numeric, errors="coerce").dropna(how="any")
     if df.shape[1] < 2 or df.shape[0] < 2:
         raise ValueError(f"measured {p}: need two numeric columns (time [s], value) and two rows at least")
@@ -638,7 +669,11 @@ def _plot(args: argparse.Namespace) -> int:
     first = Path(args.results[0])
     if len(args.results) > 1 and not set(kinds) & multi:
         raise ValueError(f"--kind {args.kind} draws one result; give one RESULT or use --kind comparison/capacity")
-    loaded = [load_result(r) for r in args.results]
+    if args.output:
+        from .cli import output_file
+
+        output_file(args.output, "-o")
+    loaded = [read_result_file(r) for r in args.results]
     for ds, r in zip(loaded, args.results):
         ds.attrs.setdefault("name", _file_label(Path(r)))
     written, skipped = [], []

@@ -68,12 +68,13 @@ def preview(model: Model, monitors: Mapping[str, tuple] | None = None, *, title:
 
 def _show(args: argparse.Namespace) -> int:
     from .case import apply_overrides, example_case, load_case, parse_case
+    from .cli import output_file
 
     if (args.case is None) == (args.example is None):
         raise ValueError("give a case file (rockdem show CASE.toml) or --example NAME")
     data = example_case(args.example) if args.example else load_case(args.case)
     case = parse_case(apply_overrides(data, args.set or []))
-    out = Path(args.output) if args.output else Path(f"{case.name}_preview.png")
+    out = output_file(args.output if args.output else f"{case.name}_preview.png", "-o")
     p = save_figure(preview(case.model, case.monitors, title=case.name), out)
     print(repr(case.model))
     print(f"rockdem show: wrote {p}")

@@ -915,6 +915,7 @@ def _records_cli(args: argparse.Namespace) -> int:
     if args.plot:
         if not args.name:
             raise ValueError("--plot needs a record: rockdem records --plot NAME (a short name, a file name or a path)")
+        from .cli import output_file
         from .spectra import save_record_plot
 
         gm = read_record(args.name)
@@ -923,6 +924,7 @@ def _records_cli(args: argparse.Namespace) -> int:
         out = Path(args.output) if args.output else Path(f"{shipped.name if shipped else Path(args.name).stem}_record.png")
         if out.suffix.lower() not in (".png", ".pdf"):
             raise ValueError(f"-o {out}: the suffix must be .png or .pdf")
+        output_file(out, "-o")
         print(f"rockdem records: wrote {save_record_plot(gm, out, name=label)} (acceleration, velocity, displacement, "
               "5 % damped response spectrum)")
         return 0

@@ -651,9 +651,9 @@ def _check_step_count(info: TimestepInfo, duration: float, max_steps: int) -> No
     steps = duration / info.dt
     if steps > max_steps:
         raise ValueError(
-            f"the run needs about {steps:.3g} steps of {info.dt:.3g} s (limit max_steps = {max_steps:.3g}): "
-            f"the contacts are implausibly stiff or the damping implausibly high {where}; raise max_steps "
-            "if this is intended"
+            f"the run of {duration:.4g} s needs about {steps:.3g} steps of {info.dt:.3g} s (limit max_steps = "
+            f"{max_steps:.3g}): shorten the duration, or the contacts are implausibly stiff or the damping "
+            f"implausibly high {where}; raise max_steps if this is intended"
         )
 
 

@@ -21,7 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from .case import Table, joint_material, specimen
-from .geometry import Polyhedron, box, convex_hull, mass_properties
+from .geometry import MAX_LENGTH, Polyhedron, box, convex_hull, mass_properties
 from .kernels.rotation import axis_angle_matrix
 from .materials import JointMaterial, real_number
 from .model import GROUND, Motion, ModelBuilder
@@ -52,8 +52,12 @@ MAX_EDGE_FACETS = 90
 
 # -- checks and small geometry helpers ------------------------------------------------------------
 def _positive(name: str, value: float, unit: str = "m") -> float:
+    """``value`` as a float, refused (naming ``name``) unless positive and finite, and for a length
+    (``unit`` "m") at most MAX_LENGTH."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be a positive number [{unit}], got {value!r}")
+    if unit == "m" and value > MAX_LENGTH:
+        raise ValueError(f"{name} = {value:g} m is beyond any structure (at most {MAX_LENGTH:g} m); lengths are in metres")
     return float(value)
 
 

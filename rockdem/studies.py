@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .cli import integer_at_least, positive_float, positive_int, stop_on_signals
+from .cli import integer_at_least, output_folder, positive_float, positive_int, stop_on_signals
 from .case import MAX_MAGNITUDE, apply_overrides, check_plausible, example_case, example_names, load_case, parse_case, read_toml
 
 __all__ = [
@@ -818,8 +818,7 @@ def _sweep(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     out = Path(args.out) if args.out else Path(args.study).with_suffix("")
     check_first_run(study.specs)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out} is an existing file; give a folder for runs.jsonl and table.csv")
+    output_folder(out, "--out", create=False)
     t0 = time.perf_counter()
     try:
         with stop_on_signals():  # SIGTERM and SIGHUP stop the sweep and its workers as Ctrl-C does
@@ -831,7 +830,18 @@ def _sweep(args: argparse.Namespace) -> int:
     n_err = int((df["status"] == "error").sum()) if "status" in df else 0
     n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0
     print(f"{len(df)} runs ({n_err} failed, {n_div} diverged) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
+    if n_err:
+        failed = df[df["status"] == "error"]
+        for _, row in failed.head(FAILED_SHOWN).iterrows():
+            print(f"rockdem sweep: run {row['id']} failed: {row['error']}", file=sys.stderr)
+        if n_err > FAILED_SHOWN:
+            print(f"rockdem sweep: {n_err - FAILED_SHOWN} more failed runs: see the error column of {out / 'table.csv'}",
+                  file=sys.stderr)
     return 0 if n_err == 0 else 1
+
+
+FAILED_SHOWN = 5
+"""Failed runs whose error a sweep prints at its end (all are in table.csv)."""
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:

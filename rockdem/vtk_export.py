@@ -36,9 +36,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 import xarray as xr
 
-from .cli import positive_int
+from .cli import output_folder, positive_int
 from .kernels.rotation import quats_to_matrices
-from .plots import Result, load_result
+from .plots import Result, load_result, read_result_file
 
 __all__ = ["VTK_POLYGON", "VTK_VERTEX", "STATE_CODES", "DEFAULT_MAX_FILES", "default_every", "export_vtk", "block_frame_data", "write_vtu", "register_cli"]
 
@@ -249,23 +249,6 @@ def export_vtk(result: Result, directory: str | Path, *, every: int = 1, contact
     return pvd
 
 
-def read_result_file(path: str | Path) -> xr.Dataset:
-    """A rockdem result read from ``path`` for a command: FileNotFoundError or ValueError naming the
-    file when it is missing, not a regular file or not a result."""
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"result file {p} does not exist (rockdem run writes OUT/result.nc)")
-    if not p.is_file():
-        raise ValueError(f"result file {p} is not a regular file; give the result.nc written by rockdem run")
-    try:
-        ds = load_result(p)
-    except (ValueError, OSError, KeyError) as exc:
-        raise ValueError(f"{p} is not a rockdem result (the NetCDF file written by rockdem run): {str(exc)[:200]}") from None
-    if "block_free" not in ds or "time" not in ds.coords:
-        raise ValueError(f"{p} is not a rockdem result: it has no block_free or time")
-    return ds
-
-
 def _export(args: argparse.Namespace) -> int:
     if not args.vtk and not args.contacts:
         raise ValueError("export: give --vtk DIR (the .vtu files and .pvd series for ParaView) and/or "
@@ -276,9 +259,7 @@ def _export(args: argparse.Namespace) -> int:
 
         print(f"rockdem export: wrote {write_contact_table(ds, args.contacts)}")
     if args.vtk:
-        out = Path(args.vtk)
-        if out.exists() and not out.is_dir():
-            raise ValueError(f"--vtk {out} is an existing file; give a folder")
+        out = output_folder(args.vtk, "--vtk")
         n = ds.sizes["time"]
         every = args.every or default_every(n)
         p = export_vtk(ds, out, every=every, contacts=not args.no_contacts)

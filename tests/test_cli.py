@@ -343,3 +343,52 @@ def test_the_progress_bar_writes_seldom_into_a_log(monkeypatch):
     bar = _progress_bar(5.0)
     assert bar.mininterval <= 0.1
     bar.close()
+
+
+def test_every_command_checks_its_output_path_and_input_files(tmp_path, capsys):
+    """Each command refuses an output path it cannot write and an input file that is not what it
+    reads with a message naming the path and exit 2, never a traceback (before 2026-11-29 plot,
+    show, animate, records --plot and export raised OSError tracebacks for a file given as a
+    folder, a truncated or empty checkpoint BadZipFile or EOFError, plot a NetCDF file that is not
+    a result KeyError)."""
+    import xarray as xr
+
+    out = tmp_path / "fr"
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.2", "--quiet", "--no-plot"]) == 0
+    capsys.readouterr()
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    result = str(out / "result.nc")
+    for argv in (["plot", result, "-o", str(afile / "x.png")],
+                 ["show", "--example", "free-rocking", "-o", str(afile / "x.png")],
+                 ["animate", result, "-o", str(afile / "x.gif")],
+                 ["records", "--plot", "elcentro-rsn6", "-o", str(afile / "x.png")],
+                 ["export", result, "--vtk", str(afile / "sub")]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert str(afile) in err and "Traceback" not in err, argv
+    saved = (out / "checkpoint.npz").read_bytes()
+    (tmp_path / "trunc.npz").write_bytes(saved[:3000])
+    (tmp_path / "empty.npz").write_bytes(b"")
+    for bad in ("trunc.npz", "empty.npz"):
+        for flag in ("--from", "--settled"):
+            assert main(["run", "--example", "free-rocking", flag, str(tmp_path / bad), "--out", str(tmp_path / "o2"), "--quiet"]) == 2
+            assert "is not a rockdem checkpoint" in capsys.readouterr().err
+    xr.Dataset({"a": ("t", np.arange(3.0))}).to_netcdf(tmp_path / "other.nc")
+    assert main(["plot", str(tmp_path / "other.nc")]) == 2
+    assert "other.nc is not a rockdem result" in capsys.readouterr().err
+    assert main(["calibrate", str(tmp_path / "other.nc"), "--base", "free-rocking", "--parameter", "damping.beta",
+                 "--bounds", "0.001", "0.01"]) == 2
+    assert "reference" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["advise", "--width", "0.2", "--height", "1", "--density", "1800", "--youngs-modulus-mpa", "1.8e9"], "stiffer than any material"),
+    (["advise", "--width", "0.2", "--height", "1", "--density", "1.8", "--youngs-modulus-mpa", "1800"], "density = 1.8 kg/m^3"),
+    (["animate", "r.nc", "--size", "100000", "480"], "at most 4096 pixels"),
+    (["animate", "r.nc", "--view", "nan,nan"], "--view"),
+    (["run"], "give a case file (rockdem run CASE.toml) or --example NAME (rockdem run --list-examples)"),
+])
+def test_implausible_command_line_values_are_refused(argv, message, capsys):
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err

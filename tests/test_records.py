@@ -513,3 +513,15 @@ def test_a_vertical_file_of_another_layout(tmp_path: Path) -> None:
     parse_case(case)
     with pytest.raises(ValueError, match="omit dt; if that column counts samples, give time_column"):
         read_record(_write(tmp_path, "i.csv", "0, 0.0, 0.1\n1, 0.01, 0.2\n2, 0.02, 0.3\n"), units="g", acc_column=2, dt=0.01)
+
+
+def test_a_window_reaching_beyond_the_record_is_warned_about() -> None:
+    """A window past the end of a record (El Centro is 53.7 s long) is used as far as the record
+    goes, and says so (before 2026-11-29 it was clipped silently)."""
+    gm = read_record("elcentro-rsn6")
+    with pytest.warns(UserWarning, match=r"window \(50, 60\) s reaches beyond the record \(0\.\.53\.7"):
+        cut = prepare_record(gm, window=(50.0, 60.0), baseline=False)
+    assert cut.duration == pytest.approx(gm.time[-1] - 50.0 + cut.dt, abs=2 * gm.dt)  # one zero sample appended
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        prepare_record(gm, window=(10.0, 40.0), baseline=False)  # inside: no warning

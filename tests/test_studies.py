@@ -387,3 +387,18 @@ def test_killed_sweep_leaves_no_worker_running(tmp_path, sig):
         for p in workers:
             if _alive(p):
                 os.kill(p, signal.SIGKILL)
+
+
+def test_a_sweep_names_why_its_failed_runs_failed(tmp_path, capsys):
+    """A grid whose second row is a bad case runs the first and prints the second's error on the
+    console, not only a count (before 2026-11-29: "2 runs (1 failed, 0 diverged)", the reason only in
+    table.csv)."""
+    from rockdem.cli import main
+
+    f = tmp_path / "s.toml"
+    f.write_text('[study]\nbase = "free-rocking"\nduration = 0.01\nexecutor = "serial"\n'
+                 '[study.grid]\n"specimen.width" = [0.2, -1.0]\n')
+    assert main(["sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"]) == 1
+    captured = capsys.readouterr()
+    assert "2 runs (1 failed, 0 diverged)" in captured.out
+    assert "failed: ValueError: [specimen] width must be positive" in captured.err
