@@ -130,10 +130,23 @@ def reference_from_row(row: Mapping[str, Any], quantity: str = "rotation") -> Re
     return Reference(np.asarray(h["time"], float), np.asarray(h[quantity], float), quantity)
 
 
+FAILED_WME = 1e3
+"""The WME a failed run (an error, a divergence) is given in a calibration: worse than any run's."""
+
+
+def failure_of_row(row: Mapping[str, Any]) -> str | None:
+    """Why a run failed (an error, a divergence), or None."""
+    if row.get("status") == "error":
+        return str(row.get("error", "error"))
+    if row.get("status") != "ok":
+        return f"diverged at {row.get('diverged_time_s', '?')} s" if row.get("status") == "diverged" else str(row.get("status"))
+    return None
+
+
 def wme_of_row(row: Mapping[str, Any], ref: Reference) -> float:
-    """WME of a run row (with history) against the reference; 1e3 for failed runs."""
-    if row.get("status") != "ok" or "history" not in row:
-        return 1e3
+    """WME of a run row (with history) against the reference; FAILED_WME for failed runs."""
+    if failure_of_row(row) is not None or "history" not in row:
+        return FAILED_WME
     h = row["history"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -151,7 +164,9 @@ class CalibrationResult:
         evaluations: every evaluated point (parameter columns, ``wme``), in evaluation order.
         curve: WME around the optimum (one parameter): ``relative_change``, value, ``wme``.
         sensitivity: largest WME increase for +-2/5/10/20 % changes (one parameter), e.g. ``{"5%": 0.12}``.
-        notes: caveats (a better point outside the bounds, a curve not centred on its minimum).
+        notes: caveats (a better point outside the bounds, a curve not centred on its minimum, runs
+            that failed).
+        failed: how many evaluated runs failed (their WME is FAILED_WME; ``evaluations.error``).
 
     The optimum is the best point evaluated within the bounds (scan, search and curve alike): the
     WME curve is re-centred on any better point it finds, so its 0 % row is the optimum.
@@ -164,6 +179,7 @@ class CalibrationResult:
     curve: pd.DataFrame | None = None
     sensitivity: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    failed: int = 0
 
     def report(self) -> str:
         """Plain-text report."""
@@ -181,7 +197,7 @@ class CalibrationResult:
 
     def to_json(self) -> dict[str, Any]:
         return {"parameters": self.parameters, "optimum": self.optimum, "wme": self.wme, "sensitivity": self.sensitivity,
-                "notes": self.notes}
+                "notes": self.notes, "failed": self.failed}
 
 
 def calibrate(
@@ -257,7 +273,7 @@ def calibrate(
     def record(s: RunSpec, row: Mapping[str, Any], values: Sequence[float]) -> float:
         if s.id not in cache:
             cache[s.id] = wme_of_row(row, reference)
-            evals.append({**dict(zip(keys, values)), "wme": cache[s.id]})
+            evals.append({**dict(zip(keys, values)), "wme": cache[s.id], "error": failure_of_row(row)})
         return cache[s.id]
 
     def batch(values_list: list[list[float]]) -> list[float]:
@@ -269,6 +285,9 @@ def calibrate(
             for s, v in zip(specs, values_list):
                 if s.id in rows:
                     record(s, rows[s.id], v)
+            if all(e["error"] is not None for e in evals):  # nothing to compare: no optimum to report
+                raise ValueError(f"calibration: every run so far failed ({len(evals)}), e.g. at "
+                                 f"{', '.join(f'{k} = {evals[0][k]:.6g}' for k in keys)}: {evals[0]['error']}")
         return [cache[s.id] for s in specs]
 
     def objective(x: Sequence[float]) -> float:
@@ -330,6 +349,11 @@ def calibrate(
             near = [wi for s, wi in zip(steps, w) if abs(abs(s) - mag) < 1e-12]
             result.sensitivity[f"{mag:.0%}"] = float(max(near) - w0)
         result.evaluations = pd.DataFrame(evals)
+    failed = [e for e in evals if e["error"] is not None]
+    if failed:
+        result.failed = len(failed)
+        result.notes.append(f"{len(failed)} of {len(evals)} runs failed (WME {FAILED_WME:g} taken there; the error column of "
+                            f"the evaluations), e.g. at {', '.join(f'{k} = {failed[0][k]:.6g}' for k in keys)}: {failed[0]['error']}")
     outside = [e for e in evals if not inside(e) and e["wme"] < result.wme]
     if outside:
         e = min(outside, key=lambda e: e["wme"])
@@ -394,12 +418,14 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
             plot_calibration(res, ref, out / "wme.png")
         (out / "calibration.json").write_text(json.dumps(res.to_json(), indent=2))
         (out / "report.txt").write_text(res.report() + "\n")
-    return 0
+    return 1 if res.failed else 0  # as a sweep with failed runs
 
 
 def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """Add ``calibrate``."""
-    p = subparsers.add_parser("calibrate", help="find a parameter minimising WME against a reference history")
+    p = subparsers.add_parser("calibrate", help="find a parameter minimising WME against a reference history",
+                              epilog="Exit status: 0 done; 1 some runs failed (counted in the report's notes; WME 1000 "
+                              "taken there); 2 bad input, or every run failed (nothing to compare).")
     p.add_argument("reference", help="reference: CSV (time, value) or a rockdem result .nc")
     p.add_argument("--base", default="free-rocking", help="base case: example name or TOML path")
     p.add_argument("--parameter", default="damping.beta", help="table.key to calibrate (damping.alpha, specimen.kn, ...)")

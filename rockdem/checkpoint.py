@@ -175,10 +175,11 @@ class Checkpoint:
         if self.fresh:
             if structure_hash(model) != self.structure_hash:
                 raise ValueError(
-                    "the checkpoint's blocks, geometry or joint materials differ from this model's: a checkpoint "
-                    "with its clock reset starts only a model with the same blocks and joints (its loading and "
-                    f"damping may differ); checkpoint blocks: {_names(self.block_names)}, model blocks: "
-                    f"{_names(model.block_names)}")
+                    "the checkpoint's blocks, geometry, joint materials or starting poses differ from this model's: a "
+                    "checkpoint with its clock reset starts only a model built as the one it was saved from, with the "
+                    "same blocks and joints standing in the same poses (its loading and damping may differ; a tilt, "
+                    "as a free-rocking release has, is a pose: tilt the blocks in the settling case too); checkpoint "
+                    f"blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}")
             return
         if model_hash(model) != self.model_hash:
             same = structure_hash(model) == self.structure_hash

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import shlex
 import signal
 import sys
 import time
@@ -282,6 +283,23 @@ def plot_rocking(ds: xr.Dataset, path: Path) -> Path:
     return save_figure(fig, path, dpi=120)
 
 
+def continue_command(args: argparse.Namespace, checkpoint: str | os.PathLike[str]) -> str:
+    """The command line that continues an interrupted ``rockdem run`` from ``checkpoint``: the same
+    case, overrides, duration, output folder and stop rule (shell-quoted)."""
+    words = ["rockdem", "run", *(["--example", args.example] if args.example else [str(args.case)])]
+    words += ["--from", str(checkpoint)]
+    for item in args.set or []:
+        words += ["--set", item]
+    for flag, value in (("--duration", args.duration), ("--out", args.out), ("--stop", args.stop),
+                        ("--checkpoint-every", args.checkpoint_every), ("--threads", args.threads)):
+        if value is not None:
+            words += [flag, str(value)]
+    for flag, on in (("--quiet", args.quiet), ("--no-plot", args.no_plot)):
+        if on:
+            words.append(flag)
+    return shlex.join(words)
+
+
 def _run(args: argparse.Namespace) -> int:
     if args.list_examples:
         print("\n".join(example_names()))
@@ -333,9 +351,7 @@ def _run(args: argparse.Namespace) -> int:
         print("  " + _row("wrote", "", "", str(p)))
     if ds.attrs.get("interrupted"):  # stopped before the end: the frames computed so far are saved
         if "checkpoint" in ds.attrs:
-            src = f"--example {args.example}" if args.example else str(args.case)
-            print(f"  continue with: rockdem run {src} --from {ds.attrs['checkpoint']}" + (" --set ..." if args.set else "")
-                  + (f" --stop {args.stop}" if args.stop else ""))
+            print(f"  continue with: {continue_command(args, ds.attrs['checkpoint'])}")
         return 128 + (received[0] if received else signal.SIGINT)
     if received:  # the signal came once every frame was computed: the result is complete and saved
         print(f"rockdem run: {signal.Signals(received[0]).name} came after the run had ended; the result is complete",

@@ -442,6 +442,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         ck.check_model(model)
         state, scratch = ck.engine_arrays(model)
         scratch.lost_block[:] = -1
+        _warn_not_at_rest(model, state)
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
     if start is not None and state.step[0] == 0:
         state.velocity_lag[0] = 0.0  # the model's initial velocities are those at t = 0 (a saved state's
@@ -453,6 +454,24 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
     snaps.take(state)
     return _Run(info, state, scratch, rec, 0, interval, snaps)
+
+
+SETTLED_KINETIC = 1e-3
+"""A state whose kinetic energy exceeds this share of the work of lifting its free blocks by 1 mm
+is not at rest: a new run started from it (--settled) is warned about."""
+
+
+def _warn_not_at_rest(model: Model, state: State) -> None:
+    """Warn when a saved state that starts a new run at t = 0 is still moving."""
+    m = model.arrays
+    free = m.block_free.astype(bool)
+    ke = 0.5 * float(np.sum(m.block_mass[free] * np.sum(state.velocity[free] ** 2, axis=1))
+                     + np.sum(m.block_inertia[free] * state.omega[free] ** 2))
+    lift = 9.81e-3 * float(m.block_mass[free].sum())
+    if ke > SETTLED_KINETIC * lift:
+        warn_user(f"the saved state that starts this run at t = 0 is not at rest: kinetic energy {ke:.3g} J "
+                  f"({ke / lift:.3g} x lifting its free blocks by 1 mm); the run starts with those velocities. "
+                  "Settle longer (or continue that run with --from)")
 
 
 def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | None, rule: str | None,
@@ -469,7 +488,8 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
              "contact_interval": (contact_interval, ck.contact_interval)}
     for name, (value, saved) in given.items():
         if value is not None and value != saved:
-            raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({saved!r}): a continued run keeps "
+            was = "automatic" if saved is None else repr(saved)
+            raise ValueError(f"{name} = {value!r} differs from the checkpoint's ({was}): a continued run keeps "
                              f"the options it was started with; leave {name} unset")
     if _frame_count(duration, ck.record_interval) <= ck.frame:
         last = float(ck.records.time[ck.frame - 1]) if ck.frame else 0.0

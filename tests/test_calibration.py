@@ -84,3 +84,25 @@ def test_an_unusable_reference_file_is_refused_with_what_it_needs(tmp_path, text
         cal.load_reference(p)
     with pytest.raises(ValueError, match="is a folder"):
         cal.load_reference(tmp_path)
+
+
+def test_failed_runs_are_counted_and_a_calibration_of_failures_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Runs that fail (an error, a divergence) are not silently WME 1000: the result counts and
+    names them, and a calibration whose runs all fail is refused instead of reporting the lower
+    bound as its optimum (before 2026-11-29: "optimum damping.beta = 0.0005, WME 1000", exit 0)."""
+    def rows(specs, *a, **k):
+        out = []
+        for s in specs:
+            beta = dict(s.overrides)["damping.beta"]
+            out.append({"id": s.id, "status": "ok", "beta": beta} if beta > 2e-3 else
+                       {"id": s.id, "status": "error", "error": "ValueError: dt above the stable bound"})
+        return out
+
+    monkeypatch.setattr(cal, "execute", rows)
+    monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: cal.FAILED_WME if r["status"] != "ok" else _surface(r["beta"]))
+    res = calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), REF, scan_points=9, executor="serial")
+    assert res.optimum["damping.beta"] > 2e-3 and res.failed > 0
+    assert res.failed == int(res.evaluations["error"].notna().sum())
+    assert any("runs failed" in n and "dt above the stable bound" in n for n in res.notes)
+    with pytest.raises(ValueError, match="every run so far failed"):
+        calibrate("free-rocking", "damping.beta", (2e-4, 1e-3), REF, scan_points=9, executor="serial")

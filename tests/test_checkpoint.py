@@ -96,7 +96,7 @@ def test_checkpoint_refuses_another_model_or_other_options(case, tmp_path):
     taller = parse_case(apply_overrides(example_case("free-rocking"), ["specimen.height=2.5"])).model
     with pytest.raises(ValueError, match="another model"):
         simulate(taller, 0.2, initial=tmp_path / "c.npz", progress=False)
-    with pytest.raises(ValueError, match="blocks, geometry or joint"):
+    with pytest.raises(ValueError, match="blocks, geometry, joint materials or starting poses"):
         simulate(taller, 0.2, initial=Checkpoint.load(tmp_path / "c.npz").reset_clock(), progress=False)
     with pytest.raises(ValueError, match="record_interval = 0.02 differs"):
         simulate(case.model, 0.2, initial=tmp_path / "c.npz", record_interval=0.02, progress=False)
@@ -239,3 +239,19 @@ def test_stop_decided_in_the_chunk_cut_by_the_end_of_a_run(resting, tmp_path):
     cont = simulate(resting, 4.0, stop="rest", initial=ck, progress=False)
     assert_identical(one, cont)
     assert cont.attrs["steps"] == one.attrs["steps"]
+
+
+def test_a_saved_state_still_moving_that_starts_a_new_run_is_warned_about(case, tmp_path):
+    """--settled starts a new run at t = 0 with the saved velocities: a state saved mid-rocking is
+    not settled, and the run says so (before 2026-11-29 it started silently); a settled one does not."""
+    import warnings
+
+    simulate(case.model, 0.5, checkpoint=tmp_path / "moving.npz", **RUN)
+    with pytest.warns(UserWarning, match="is not at rest: kinetic energy"):
+        simulate(case.model, 0.05, initial=Checkpoint.load(tmp_path / "moving.npz").reset_clock(), **RUN)
+    data = {**example_case("free-rocking"), "loading": {"type": "gravity"}, "damping": {"beta": 0.005}}
+    model = parse_case(data).model
+    simulate(model, 0.5, checkpoint=tmp_path / "settled.npz", **RUN)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        simulate(model, 0.05, initial=Checkpoint.load(tmp_path / "settled.npz").reset_clock(), **RUN)

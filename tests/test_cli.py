@@ -392,3 +392,23 @@ def test_every_command_checks_its_output_path_and_input_files(tmp_path, capsys):
 def test_implausible_command_line_values_are_refused(argv, message, capsys):
     assert main(argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_continue_command_of_an_interrupted_run_keeps_its_options(tmp_path):
+    """The printed command that continues an interrupted run carries its overrides, duration,
+    output folder and stop rule (before 2026-11-29 it printed "--set ..." and dropped --duration
+    and --out: the continued run ended at the case file's duration, in another folder)."""
+    import shlex
+
+    from rockdem.cli import build_parser
+    from rockdem.run_cli import continue_command
+
+    argv = ["run", "my case.toml", "--duration", "12.5", "-o", str(tmp_path / "out dir"), "--set", "damping.beta=0.005",
+            "--set", 'loading.record="nahanni"', "--stop", "rest", "--quiet"]
+    args = build_parser("run").parse_args(argv)
+    words = shlex.split(continue_command(args, tmp_path / "out dir" / "checkpoint.npz"))
+    assert words[:2] == ["rockdem", "run"]
+    again = build_parser("run").parse_args(words[1:])
+    assert again.from_ == str(tmp_path / "out dir" / "checkpoint.npz") and again.settled is None
+    for name in ("case", "duration", "out", "set", "stop", "quiet", "example", "threads", "no_plot"):
+        assert getattr(again, name) == getattr(args, name), name
