@@ -454,9 +454,12 @@ def rocking_onset_time(t: ArrayLike, theta: ArrayLike, threshold: float) -> floa
 
 
 def first_impact_time(t: ArrayLike, theta: ArrayLike, threshold: float | None = None) -> float | None:
-    """Time of the first impact [s]: the first zero crossing of the rotation after it first exceeds
-    ``threshold`` (a block released from a tilt, or rocking under an input), linearly interpolated
-    between samples; None if it never crosses.
+    """Time of the first impact [s] after the rotation first exceeds ``threshold`` (a block
+    released from a tilt, or rocking under an input): its first zero crossing, linearly
+    interpolated between samples, or, for one-sided rocking (a façade against its return walls,
+    which comes back to zero and rebounds without crossing), its first return to zero: the vertex of
+    the V of its first dip below ``threshold`` (where the lines of its descent and of its rebound,
+    through the two samples either side of the dip's deepest one, meet). None if it never comes back.
 
     Args:
         t: (n,) time [s].
@@ -470,11 +473,30 @@ def first_impact_time(t: ArrayLike, theta: ArrayLike, threshold: float | None = 
         return None
     i0 = above[0]
     sign = np.sign(th[i0])
-    cross = np.flatnonzero(np.sign(th[i0:]) == -sign)
-    if not len(cross):
+    s = sign * th[i0:]  # > 0 on the side it was released to
+    dip = np.flatnonzero(s <= thr)
+    if not len(dip):
         return None
-    i = i0 + cross[0]
-    return float(t[i - 1] + (t[i] - t[i - 1]) * th[i - 1] / (th[i - 1] - th[i]))
+    j = dip[0]
+    if s[j] < 0.0:  # crossed zero between two samples
+        i = i0 + j
+        return float(t[i - 1] + (t[i] - t[i - 1]) * th[i - 1] / (th[i - 1] - th[i]))
+    end = np.flatnonzero(s[j:] > thr)
+    stop = j + (end[0] if len(end) else len(s) - j)
+    k = j + int(np.argmin(s[j:stop]))  # the deepest sample of the dip
+    if s[k] < 0.0:  # it crosses inside the dip: the crossing
+        i = i0 + j + int(np.flatnonzero(s[j:stop] < 0.0)[0])
+        return float(t[i - 1] + (t[i] - t[i - 1]) * th[i - 1] / (th[i - 1] - th[i]))
+    i = i0 + k
+    if i < 2 or i + 2 >= len(t):
+        return float(t[i])
+    down = (th[i - 1] - th[i - 2]) * sign / (t[i - 1] - t[i - 2])  # the descent's slope, < 0
+    up = (th[i + 2] - th[i + 1]) * sign / (t[i + 2] - t[i + 1])  # the rebound's, > 0
+    if not (down < 0.0 < up):
+        return float(t[i])
+    a, b = sign * th[i - 1], sign * th[i + 1]
+    vertex = (b - a + down * t[i - 1] - up * t[i + 1]) / (down - up)
+    return float(min(max(vertex, t[i - 1]), t[i + 1]))
 
 
 SUMMARY_PEAK_PROMINENCE = 0.02

@@ -404,3 +404,19 @@ def test_a_history_ending_at_eta_has_exceeded_it():
     eta = 0.2
     s = summarize(t, eta * t, eta=eta)
     assert s["overturned"] and s["exceeded_eta"]
+
+
+@pytest.mark.parametrize("one_sided", [False, True])
+@pytest.mark.parametrize("dt", [0.001, 0.0037])
+def test_first_impact_of_two_and_one_sided_rocking_is_housners_quarter_period(one_sided, dt):
+    """A block released at 0.6 eta hits at Housner's quarter period, rocking about both edges
+    (a zero crossing) or one-sided against a return wall (it comes back to zero and rebounds without
+    crossing: None before 2026-11-29), whatever the sampling."""
+    from rockdem.analysis import first_impact_time
+    from rockdem.housner import HousnerBlock, quarter_period, rock
+
+    block = HousnerBlock(0.25, 1.2)
+    r = rock(block, theta0=0.6 * block.eta, duration=2.0, e=0.8, one_sided=one_sided)
+    t = np.arange(0.0, 2.0, dt)
+    th = np.interp(t, r.time, r.rotation)
+    assert first_impact_time(t, th) == pytest.approx(quarter_period(block, 0.6 * block.eta), abs=0.1 * dt)
