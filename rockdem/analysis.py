@@ -273,6 +273,7 @@ def wme(
     *,
     cut_at_rest: bool = True,
     rest_tol: float | None = None,
+    overlap_only: bool = False,
 ) -> float:
     """Weighted mean error between a reference and a simulated history (paper §3.1).
 
@@ -287,12 +288,16 @@ def wme(
         cut_at_rest: keep only the reference samples up to the end of the reference motion
             (:func:`rest_time`), so the late low-amplitude motion of the simulation does not count.
         rest_tol: motion threshold for the cut, unit of x; default 1 % of the reference's range.
+        overlap_only: compare over the times the simulation covers when it does not cover the
+            reference's (warned about); by default that is refused: a history cut short (a
+            stopped run) would read as a match over what it has.
 
     Returns:
         WME [-].
 
     Raises:
-        ValueError: bad histories, no overlap, or a reference identically zero.
+        ValueError: bad histories, no overlap, a simulation that does not cover the reference (unless
+            ``overlap_only``), or a reference identically zero.
     """
     tr, xr = _history(t_ref, x_ref, "wme reference")
     ts, xs = _history(t_sim, x_sim, "wme simulation")
@@ -302,6 +307,11 @@ def wme(
     if not np.any(inside):
         raise ValueError("wme: the simulation does not overlap the reference in time")
     if np.count_nonzero(inside) < np.count_nonzero(keep):
+        if not overlap_only:
+            raise ValueError(
+                f"wme: the simulation covers [{ts[0]:.4g}, {ts[-1]:.4g}] s only and the reference runs to {t_end:.4g} s: "
+                "a history cut short would read as a match over what it has; run it longer, cut the reference, or "
+                "pass overlap_only=True")
         warn_user(
             f"wme: the simulation covers [{ts[0]:.4g}, {ts[-1]:.4g}] s only; reference samples up to "
             f"{t_end:.4g} s outside it are ignored")

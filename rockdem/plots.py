@@ -611,7 +611,7 @@ def plot_comparison(
             ref = (t, y)
             ax.plot(t, y, color="k", lw=1.6, label=f"{lab} (reference)")
             continue
-        err = wme(ref[0], ref[1], t, y)
+        err = wme(ref[0], ref[1], t, y, overlap_only=True)  # warned about when it covers less than the reference
         ax.plot(t, y, color=f"C{k}", label=f"{lab} (WME = {err:.3f})")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("top displacement u/B [-]" if quantity == "displacement" else "rotation θ [rad]")

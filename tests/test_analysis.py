@@ -83,8 +83,10 @@ def test_wme_errors() -> None:
         wme(T, X, T + 10.0, X)
     with pytest.raises(ValueError, match="increasing"):
         wme(T[::-1], X, T, X)
-    with pytest.warns(UserWarning, match="covers"):
+    with pytest.raises(ValueError, match="covers"):  # a warning before 2026-11-29
         wme(T, X, T[:1000], X[:1000], cut_at_rest=False)
+    with pytest.warns(UserWarning, match="covers"):
+        wme(T, X, T[:1000], X[:1000], cut_at_rest=False, overlap_only=True)
 
 
 def test_apparent_restitution_inverts_eq_6() -> None:
@@ -420,3 +422,14 @@ def test_first_impact_of_two_and_one_sided_rocking_is_housners_quarter_period(on
     t = np.arange(0.0, 2.0, dt)
     th = np.interp(t, r.time, r.rotation)
     assert first_impact_time(t, th) == pytest.approx(quarter_period(block, 0.6 * block.eta), abs=0.1 * dt)
+
+
+def test_wme_of_a_simulation_that_does_not_cover_the_reference_is_refused():
+    """A history cut short is not a match: its WME over what it has was 0 (a warning only, which a
+    calibration silences) before 2026-11-29; now refused unless asked for over the overlap."""
+    t = np.linspace(0.0, 4.0, 401)
+    x = np.exp(-0.3 * t) * np.sin(2 * np.pi * t)
+    with pytest.raises(ValueError, match="covers .* only"):
+        wme(t, x, t[:200], x[:200], cut_at_rest=False)
+    with pytest.warns(UserWarning, match="outside it are ignored"):
+        assert wme(t, x, t[:200], x[:200], cut_at_rest=False, overlap_only=True) == 0.0
