@@ -245,12 +245,15 @@ def run_model(
         raise ValueError("give start (a prepared fresh start) or initial (a checkpoint), not both")
     ck = None if initial is None else load_checkpoint(initial)
     wall0 = _time.perf_counter()
-    if ck is None or ck.fresh:
-        run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
-                         contact_interval, max_steps, start)
-    else:
-        run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
-                             contact_interval, max_steps)
+    # A stop signal while the start's kernels load (or compile, minutes on a first run) is held until
+    # they are ready: raised inside Numba's compiler it left a half-built kernel and a traceback.
+    with _deferred_signals(note="rockdem: stopping once the compiled kernels are loaded (a first run compiles them)"):
+        if ck is None or ck.fresh:
+            run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
+                             contact_interval, max_steps, start)
+        else:
+            run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots,
+                                 record_interval, contact_interval, max_steps)
     saver = _Saver(model, run, checkpoint, checkpoint_every)
     info, state, scratch, rec, snaps = run.info, run.state, run.scratch, run.records, run.snaps
     frame, frames = run.frame, rec.time.shape[0]
@@ -542,15 +545,15 @@ class _Saver:
 
 
 @contextlib.contextmanager
-def _deferred_signals(finishing: bool = False, late: list[int] | None = None) -> Iterator[None]:
+def _deferred_signals(finishing: bool = False, late: list[int] | None = None, note: str | None = None) -> Iterator[None]:
     """Hold SIGINT, SIGTERM and SIGHUP (those with a Python handler) until the block ends, then
     deliver them to their handlers: a Ctrl-C raises its KeyboardInterrupt after the block, never
     halfway through it. With ``finishing`` (the result of a run being put together once its loop
     has ended: every frame computed, or those before a stop), the KeyboardInterrupt the handler
     raises is caught, so that the result is returned; the handler has seen the signal (``rockdem
     run`` then notes it and exits once the result is saved), and its number is appended to ``late``
-    (a study then stores no row of the run and stops). Outside the main thread (where no signal
-    arrives) this does nothing."""
+    (a study then stores no row of the run and stops). ``note`` is printed on stderr when the first
+    signal is held. Outside the main thread (where no signal arrives) this does nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -561,7 +564,7 @@ def _deferred_signals(finishing: bool = False, late: list[int] | None = None) ->
         handler = signal.getsignal(sig) if sig is not None else None
         if callable(handler):
             old[sig] = handler
-            signal.signal(sig, lambda signum, frame: held.append((signum, frame)))
+            signal.signal(sig, lambda signum, frame: _hold(held, signum, frame, note))
     try:
         yield
     finally:
@@ -575,6 +578,13 @@ def _deferred_signals(finishing: bool = False, late: list[int] | None = None) ->
                     raise
                 if late is not None:
                     late.append(int(signum))
+
+
+def _hold(held: list[tuple[int, Any]], signum: int, frame: Any, note: str | None) -> None:
+    """A stop signal held by :func:`_deferred_signals` (``note`` on stderr at the first)."""
+    if note and not held:
+        print(note, file=sys.stderr, flush=True)
+    held.append((signum, frame))
 
 
 SINK_FRACTION = 0.25

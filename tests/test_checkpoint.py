@@ -255,3 +255,25 @@ def test_a_saved_state_still_moving_that_starts_a_new_run_is_warned_about(case, 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         simulate(model, 0.05, initial=Checkpoint.load(tmp_path / "settled.npz").reset_clock(), **RUN)
+
+
+def test_a_stop_signal_while_the_start_loads_is_held_until_it_is_ready(case, monkeypatch, capsys):
+    """A SIGTERM while the start's kernels load (a first run compiles them, minutes) waits until they
+    are ready, then stops the run: raised inside Numba's compiler it left a half-built kernel
+    ("no compiled object yet") and a traceback, exit 1 (before 2026-11-29)."""
+    from rockdem.cli import stop_on_signals
+
+    real = simulation._fresh_run
+    finished = []
+
+    def slow_start(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGTERM)  # arrives while the kernels "load"
+        run = real(*args, **kwargs)
+        finished.append(True)
+        return run
+
+    monkeypatch.setattr(simulation, "_fresh_run", slow_start)
+    with stop_on_signals(), pytest.raises(KeyboardInterrupt):
+        simulate(case.model, 0.2, **RUN)
+    assert finished == [True]
+    assert "stopping once the compiled kernels are loaded" in capsys.readouterr().err
