@@ -21,14 +21,10 @@ from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, pos
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
 from .loading import EQUILIBRIUM_TOLERANCE, load_carried
 from .results import export_csv, save, write_contact_table
-from .simulation import _deferred_signals, simulate
+from .simulation import LIFT_1MM, _deferred_signals, simulate
 from .stopping import STOP_MODES
 
 __all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
-
-LIFT = 9.81e-3
-"""Work of lifting 1 kg by 1 mm [J]: the energy unit below which a run's energies are noise (as the
-engine's divergence check's floor, :func:`rockdem.kernels.step.check_frame`)."""
 
 
 def run_case(
@@ -137,7 +133,7 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             errors = ds.energy_balance_error_relative.values
             err = float(np.max(np.abs(errors)))
             joules = float(np.max(np.abs(ds.energy_balance_error.values))) if "energy_balance_error" in ds else 0.0
-            lift = LIFT * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum()) if "block_mass" in ds else 0.0
+            lift = LIFT_1MM * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum()) if "block_mass" in ds else 0.0
             if err > 0.0 and joules / err < 1e-3 * lift:
                 # nothing moved (no gravity, no loading): the scale the error is divided by is noise
                 lines.append(_row("energy balance error", f"{joules:.2e}", "J", "largest, absolute: the run's energies stay "

@@ -71,6 +71,10 @@ _MAX_RECORD_BYTES = 2 * 1024**3
 DEFAULT_MAX_STEPS = 1_000_000_000
 """Largest number of steps a run may need before it is refused (raise it with ``max_steps``)."""
 
+LIFT_1MM = 9.81e-3
+"""Work of lifting 1 kg by 1 mm [J/kg]: times the free mass, the least energy scale of a run (the
+divergence check's floor; below 1e-3 of it a run's energies are noise)."""
+
 
 def simulate(
     model: Model,
@@ -454,7 +458,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)
     m = model.arrays
-    scratch.energy_scale[0] = 9.81e-3 * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
+    scratch.energy_scale[0] = LIFT_1MM * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
     snaps.take(state)
     return _Run(info, state, scratch, rec, 0, interval, snaps)
 
@@ -470,7 +474,7 @@ def _warn_not_at_rest(model: Model, state: State) -> None:
     free = m.block_free.astype(bool)
     ke = 0.5 * float(np.sum(m.block_mass[free] * np.sum(state.velocity[free] ** 2, axis=1))
                      + np.sum(m.block_inertia[free] * state.omega[free] ** 2))
-    lift = 9.81e-3 * float(m.block_mass[free].sum())
+    lift = LIFT_1MM * float(m.block_mass[free].sum())
     if ke > SETTLED_KINETIC * lift:
         warn_user(f"the saved state that starts this run at t = 0 is not at rest: kinetic energy {ke:.3g} J "
                   f"({ke / lift:.3g} x lifting its free blocks by 1 mm); the run starts with those velocities. "
@@ -745,7 +749,7 @@ def first_diverged_frame(ds: xr.Dataset) -> int | None:
     work = ds.work_driven.values + ds.work_body.values
     err = (mech - mech[0]) - (work - work[0])
     parts = [np.abs(ds[n].values) for n in ds.data_vars if n.startswith(("energy_", "work_")) and "balance" not in n]
-    floor = 9.81e-3 * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum())  # 1 mm of lift
+    floor = LIFT_1MM * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum())
     running = np.maximum(np.maximum.accumulate(np.sum(parts, axis=0)), floor)
     finite = np.isfinite(ds.block_position.values).all(axis=(1, 2)) & np.isfinite(err)
     bad = ~finite | (err > DIVERGENCE_ERROR * running)
