@@ -126,14 +126,21 @@ RESULT_VARIABLES = ("block_free", "block_name", "block_position", "rocking_angle
 """Variables every result of rockdem run or simulate holds (the commands check for them)."""
 
 
+def input_file(path: str | Path, what: str, give: str) -> Path:
+    """``path`` as a Path once it is an existing regular file; else FileNotFoundError or ValueError
+    naming it as ``what`` and saying what to ``give``."""
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{what} {p} does not exist; give {give}")
+    if not p.is_file():
+        raise ValueError(f"{what} {p} is not a regular file; give {give}")
+    return p
+
+
 def read_result_file(path: str | Path, what: str = "result file") -> xr.Dataset:
     """A rockdem result read from ``path`` for a command: FileNotFoundError or ValueError naming the
     file (as ``what``) when it is missing, not a regular file, not a result or holds no frame."""
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"{what} {p} does not exist (rockdem run writes OUT/result.nc)")
-    if not p.is_file():
-        raise ValueError(f"{what} {p} is not a regular file; give the result.nc written by rockdem run")
+    p = input_file(path, what, "the result.nc written by rockdem run (OUT/result.nc)")
     try:
         ds = load_result(p)
     except (ValueError, OSError, KeyError) as exc:
@@ -530,11 +537,7 @@ def read_history_csv(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """
     import pandas as pd
 
-    p = Path(path)
-    if not p.exists():
-        raise FileNotFoundError(f"measured history {p} does not exist")
-    if not p.is_file():
-        raise ValueError(f"measured history {p} is not a file; give a CSV or text file of time [s] and value")
+    p = input_file(path, "measured history", "a CSV or text file of time [s] and value")
     try:
         df = pd.read_csv(p, sep=None, engine="python", comment="#", header=None)
     except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError, csv.Error) as exc:
