@@ -467,7 +467,10 @@ def pushover(
     """
     ramp = apply_pushover(builder, rate=rate, max_load_factor=max_load_factor, direction=direction)
     base = Damping() if damping is None else damping
-    model = builder.finalize(damping=replace(base, local=local_damping))
+    # rotation about up x d, positive along the load, as the case files' pushover (a push along +y
+    # measured its rocking about y, ~0, before 2026-11-29)
+    model = builder.finalize(damping=replace(base, local=local_damping),
+                             rocking_axis=rocking_axis_of(direction, builder.gravity))
     duration = ramp.ramp_time if duration is None else duration
     if record_interval is None:
         record_interval = duration / 500.0
