@@ -150,7 +150,7 @@ def _parapet_runs(ctx: Context) -> tuple[pd.DataFrame, dict[str, Any]]:
         h = row["history"]
         out.append({"beta": label, "beta [s]": float(row.get("beta_s", row.get("damping.beta"))),
                     "e_a mean": row["e_a_mean"], "e_a/e_eta": row["e_a_mean"] / housner_e_eta(eta),
-                    "WME vs the paper's best fit": wme(ref["time"], ref["displacement"], h["time"], h["displacement"]),
+                    "WME vs the paper's best fit": wme(ref["time"], ref["displacement"], h["time"], h["displacement"], overlap_only=True),
                     "rest time [s]": rest_time(h["time"], h["displacement"])})
     return pd.DataFrame(out), rows
 

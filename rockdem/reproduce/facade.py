@@ -207,7 +207,7 @@ def _free_summary(r: FacadeRun) -> dict[str, Any]:
         warnings.simplefilter("ignore")
         ea = apparent_restitution(pk[1:], th0, eta).per_impact if len(pk) > 1 else np.zeros(0)
         hz = _housner(t, th)
-        w = wme(hz.time + t[0], hz.rotation, t, th)
+        w = wme(hz.time + t[0], hz.rotation, t, th, overlap_only=True)
     return {
         "model": r.label, "alpha [1/s]": r.alpha, "beta [s]": r.beta, "E [MPa]": r.youngs_modulus / 1e6,
         "outward excursions": len(pk), "1st rebound / release": float(pk[1] / th0) if len(pk) > 1 else 0.0,

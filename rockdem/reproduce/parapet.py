@@ -213,9 +213,10 @@ def _free_table(free: Sequence[FreeRun], disc: Sequence[FreeRun]) -> pd.DataFram
         _, ea = restitution(t, th, _eta(th))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            w_sp = wme(t_ref, u_ref, t, u) if ref is not None and r is not ref else (0.0 if r is ref else float("nan"))
+            # (the reduced runs can be shorter than the reference: compared over what they cover)
+            w_sp = wme(t_ref, u_ref, t, u, overlap_only=True) if ref is not None and r is not ref else (0.0 if r is ref else float("nan"))
             hz = rock(blk, theta0=float(th[0]), duration=float(t[-1]), dt_out=RECORD_INTERVAL)
-            w_h = wme(hz.time, hz.rotation, t, th)
+            w_h = wme(hz.time, hz.rotation, t, th, overlap_only=True)
         pub = paper.PARAPET_DISCRETISED.get((r.cohesion, r.tension), (float("nan"), float("nan"))) if r in disc else (float("nan"),) * 2
         rows.append({
             "model": r.label, "alpha [1/s]": r.alpha, "beta [s]": r.beta,

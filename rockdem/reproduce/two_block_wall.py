@@ -159,7 +159,7 @@ def _free_summary(r: WallRun, ref: WallRun | None) -> dict[str, Any]:
         tr, dr = _after_release(ref)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            w = wme(tr, dr, t, d)
+            w = wme(tr, dr, t, d, overlap_only=True)
     elif ref is r:
         w = 0.0
     return {
@@ -185,7 +185,7 @@ def _quake_summary(runs: Sequence[WallRun]) -> pd.DataFrame:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 try:
-                    w = wme(tr, dr, t, d, cut_at_rest=False)
+                    w = wme(tr, dr, t, d, cut_at_rest=False, overlap_only=True)
                 except ValueError:
                     w = float("nan")
         rows.append({"record": r.record, "scale": r.scale, "model": r.label,
