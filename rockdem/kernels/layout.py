@@ -277,7 +277,7 @@ class Scratch(NamedTuple):
     block_rhs: np.ndarray  # (nb, 6) their right-hand side without the partners' coupling
     block_iterate: np.ndarray  # (2, nb, 6) velocity (world) and angular velocity (body) iterates (Jacobi sweeps)
     block_damped: np.ndarray  # (nb,) bool the block has an active dashpot this step
-    driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots)
+    driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots, driven work)
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
     poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
     chunk_poly: np.ndarray  # (LAW_CHUNKS, 2, 32, 2) the same for each chunk of the parallel law pass

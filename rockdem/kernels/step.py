@@ -276,8 +276,12 @@ def integrate_velocities(
                 for i in range(3):
                     rec.driven_reaction[f, jd, i] = -sc.force[b, i]
             jd += 1
+            # its displacement over the velocity interval [t - lag, t + step / 2]: the last velocity
+            # over the lag, the new one over half the step (a rod starting to withdraw at 10 m/s
+            # booked the new one over the whole interval: 4.8 J where the wall's spring held 0.27 J)
+            lag = dt - 0.5 * step
             for i in range(3):
-                w_drv -= sc.force[b, i] * s.velocity[b, i] * dt
+                w_drv -= sc.force[b, i] * (sc.driven_velocity_last[b, i] * lag + s.velocity[b, i] * 0.5 * step)
         for f in range(frame, frame_end):
             _record_pose(s, sc, rec, f, b, f * interval - t, dt, w_old, w_new)
     s.energy[E_DAMPING_MASS] += e_mp
@@ -367,25 +371,44 @@ def block_speed(m: ModelArrays, s: State, b: int, c0: float = 0.0, c1: float = 0
             + math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2) * m.block_radius[b])
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _next_velocity(m: ModelArrays, s: State, sc: Scratch, b: int, t: float) -> tuple[float, float, float]:
+    """Velocity [m/s] of block b over the next position step: its own, or for a driven block with a
+    prescribed motion that motion's at ``t`` (the next step's middle)."""
+    k = m.block_motion[b]
+    if m.block_free[b] or k < 0:
+        return s.velocity[b, 0], s.velocity[b, 1], s.velocity[b, 2]
+    v = sc.driven_velocity
+    interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t, v)
+    return v[0], v[1], v[2]
+
+
 @njit(cache=True, _nrt=False)
-def kinematic_step(m: ModelArrays, s: State) -> float:
+def kinematic_step(m: ModelArrays, s: State, sc: Scratch, t: float) -> float:
     """The longest step [s] in which no block's points move, relative to the others, by more than
     KINEMATIC_SHARE of the tracking tolerance: speeds |v - c| + |omega| r, c the mid-range of the
     blocks' velocities (a common translation, the ground's under an earthquake, moves no block
-    relative to another); +inf when nothing moves."""
+    relative to another); +inf when nothing moves. A driven block counts with the velocity its
+    motion prescribes for the next step (at ``t`` [s], its middle at the present step): a rod that
+    starts withdrawing at 10 m/s moved 6 mm in its first step, 8 times its contact's overlap, and
+    that contact's release booked 4.8 J of work where its spring held 0.27 J."""
     nb = m.block_mass.shape[0]
     lo0 = lo1 = lo2 = np.inf
     hi0 = hi1 = hi2 = -np.inf
     for b in range(nb):
         if s.fell_off[b] < 0.0:
-            lo0, hi0 = min(lo0, s.velocity[b, 0]), max(hi0, s.velocity[b, 0])
-            lo1, hi1 = min(lo1, s.velocity[b, 1]), max(hi1, s.velocity[b, 1])
-            lo2, hi2 = min(lo2, s.velocity[b, 2]), max(hi2, s.velocity[b, 2])
+            v0, v1, v2 = _next_velocity(m, s, sc, b, t)
+            lo0, hi0 = min(lo0, v0), max(hi0, v0)
+            lo1, hi1 = min(lo1, v1), max(hi1, v1)
+            lo2, hi2 = min(lo2, v2), max(hi2, v2)
     c0, c1, c2 = 0.5 * (lo0 + hi0), 0.5 * (lo1 + hi1), 0.5 * (lo2 + hi2)
     speed = 0.0
     for b in range(nb):
         if s.fell_off[b] < 0.0:
             speed = max(speed, block_speed(m, s, b, c0, c1, c2))
+            if not m.block_free[b] and m.block_motion[b] >= 0:  # (a driven block does not rotate)
+                v0, v1, v2 = _next_velocity(m, s, sc, b, t)
+                speed = max(speed, math.sqrt((v0 - c0) ** 2 + (v1 - c1) ** 2 + (v2 - c2) ** 2))
     return KINEMATIC_SHARE * m.contact_tol / speed if speed > 0.0 else np.inf
 
 
@@ -547,7 +570,7 @@ def advance(
         # block is fast changes at every step, and the leapfrog then books the impacts' dashpot
         # work wrongly (a façade toppling with SP damping: balance 4.9 % against 2.3 %) and a
         # continuous cap created 10 % of the two-block wall's energy scale under Nahanni.
-        dt_kin = kinematic_step(m, s)
+        dt_kin = kinematic_step(m, s, sc, s.time[0] + 0.5 * s.dt[0])
         if dt_kin < s.dt[0]:
             s.dt[0] = dt_kin
         dt = s.dt[0]
