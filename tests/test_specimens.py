@@ -386,20 +386,22 @@ def test_case_files_take_the_foundation_extent(example):
             parse_case(apply_overrides(data, [f"specimen.foundation_extent={bad}"]))
 
 
-@pytest.mark.parametrize("speed", [1.0, 10.0])
-def test_a_withdrawing_rod_gives_back_no_more_than_its_contact_held(speed):
+@pytest.mark.parametrize("speed, damped", [(1.0, False), (10.0, False), (10.0, True)])
+def test_a_withdrawing_rod_gives_back_no_more_than_its_contact_held(speed, damped):
     """The two-block wall's push rod withdraws (the shipped example at 1 m/s, and at 10 m/s),
     undamped: no energy is created at any frame (KE + PE + elastic - initial - work within 1 % of
     the energy scale). Before 2026-11-29 the rod's first withdrawing step moved it 6 mm (at 10 m/s,
     8 times its contact's overlap) and its work was booked with the new velocity over the whole
     velocity interval: 4.8 J where the wall's spring held 0.27 J, 13 % of the scale created (1 m/s:
     1.5 %, as in the example). The step now looks ahead at a driven block's prescribed velocity, and
-    a driven block's work is its displacement over the interval (the last velocity over the lag)."""
+    a driven block's work is its displacement over the interval (the last velocity over the lag),
+    in the SP dashpots' dissipation too: with the example's beta at 10 m/s the balance was off by
+    42 % (the dashpots' work booked with the rod's new velocity over the whole interval)."""
     from rockdem.case import apply_overrides, load_case
 
     root = Path(__file__).resolve().parents[1]
     data = apply_overrides(load_case(root / "examples" / "two_block_wall_free_rocking.toml"),
-                           ["damping.beta=0", "run.duration=2.0", f"specimen.withdraw_speed={speed}"])
+                           [*([] if damped else ["damping.beta=0"]), "run.duration=2.0", f"specimen.withdraw_speed={speed}"])
     ds = run_case(parse_case(data), progress=False)
     mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
     work = (ds.work_driven + ds.work_body).values
@@ -407,4 +409,4 @@ def test_a_withdrawing_rod_gives_back_no_more_than_its_contact_held(speed):
     err, rel = ds.energy_balance_error.values, ds.energy_balance_error_relative.values
     scale = float(np.max(np.abs(err) / np.maximum(np.abs(rel), 1e-300)))
     assert created.max() <= 0.01 * scale
-    assert abs(rel[-1]) <= 0.01
+    assert abs(rel[-1]) <= (0.005 if damped else 0.01)

@@ -333,18 +333,21 @@ def _new_point_velocity(s: State, sc: Scratch, b: int, x0: float, x1: float, x2:
 
 @njit(cache=True, _nrt=False, inline="always")
 def _mid_relative_velocity(
-    m: ModelArrays, s: State, sc: Scratch, o: int, t: int, x0: float, x1: float, x2: float, w0: float, w1: float, w2: float
+    m: ModelArrays, s: State, sc: Scratch, o: int, t: int, x0: float, x1: float, x2: float, w0: float, w1: float, w2: float,
+    drift: float,
 ) -> tuple[float, float, float]:
     """Relative velocity (o minus t) [m/s] at world x over the step from w, its value at the last
     half step: a free block's point velocity at the mid-step (the mean of old and new, as the
-    kinetic energy), a driven block's its velocity over the step (as its work, ``W_DRIVEN``)."""
+    kinetic energy), a driven block's its displacement over the velocity interval [t - lag, t + step
+    / 2] divided by its length h (as its work, ``W_DRIVEN``): (v_last lag + v_new step / 2) / h, the
+    mean of the two less ``drift`` (v_new - v_last) / 2, drift = (2 lag - h) / h."""
     uo0, uo1, uo2 = _new_point_velocity(s, sc, o, x0, x1, x2)
     ut0, ut1, ut2 = _new_point_velocity(s, sc, t, x0, x1, x2)
     v0, v1, v2 = 0.5 * (w0 + uo0 - ut0), 0.5 * (w1 + uo1 - ut1), 0.5 * (w2 + uo2 - ut2)
     for side in range(2):
         b = o if side == 0 else t
         if not m.block_free[b]:  # w had its last velocity, a driven block has no rotation
-            sign = 0.5 if side == 0 else -0.5
+            sign = -0.5 * drift if side == 0 else 0.5 * drift
             v0 += sign * (s.velocity[b, 0] - sc.driven_velocity_last[b, 0])
             v1 += sign * (s.velocity[b, 1] - sc.driven_velocity_last[b, 1])
             v2 += sign * (s.velocity[b, 2] - sc.driven_velocity_last[b, 2])
@@ -359,6 +362,7 @@ def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
     and to the blocks' forces and torques and the reaction of the driven blocks). Returns the energy
     dissipated over the step, h sum_k v_mid^T C_k v_mid [J] (the work of the applied forces)."""
     e = 0.0
+    drift = (2.0 * s.velocity_lag[0] - h) / h  # a driven block's velocity over the interval (_mid_relative_velocity)
     for i in range(s.pair_count[0]):
         edge, a, b, k0, k1, split = _pair_range(m, s, i)
         for k in range(k0, k1):
@@ -371,7 +375,7 @@ def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
                 # step applied at the last half step's velocity (forces._release_pass): its work.
                 if fd[0] == 0.0 and fd[1] == 0.0 and fd[2] == 0.0:
                     continue
-                vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vd[0], vd[1], vd[2])
+                vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vd[0], vd[1], vd[2], drift)
                 e -= h * (fd[0] * vm0 + fd[1] * vm1 + fd[2] * vm2)
                 continue
             fc = sc.pair_force[i] if edge else sc.contact_force[k]
@@ -383,7 +387,7 @@ def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
             g0 = -0.5 * (cs * vp0 + pn * n0)  # -C v_rel+ / 2: the half not yet applied
             g1 = -0.5 * (cs * vp1 + pn * n1)
             g2 = -0.5 * (cs * vp2 + pn * n2)
-            vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vm0, vm1, vm2)
+            vm0, vm1, vm2 = _mid_relative_velocity(m, s, sc, o, t, x0, x1, x2, vm0, vm1, vm2, drift)
             fd[0] += g0
             fd[1] += g1
             fd[2] += g2
