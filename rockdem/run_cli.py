@@ -21,7 +21,7 @@ from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, pos
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
 from .loading import EQUILIBRIUM_TOLERANCE, load_carried
 from .results import export_csv, save, write_contact_table
-from .simulation import LIFT_1MM, _deferred_signals, simulate
+from .simulation import LIFT_1MM, REST_SHARE, _deferred_signals, simulate
 from .stopping import STOP_MODES
 
 __all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
@@ -134,7 +134,7 @@ def summary_lines(ds: xr.Dataset) -> list[str]:
             err = float(np.max(np.abs(errors)))
             joules = float(np.max(np.abs(ds.energy_balance_error.values))) if "energy_balance_error" in ds else 0.0
             lift = LIFT_1MM * float(ds.block_mass.values[ds.block_free.values.astype(bool)].sum()) if "block_mass" in ds else 0.0
-            if err > 0.0 and joules / err < 1e-3 * lift:
+            if err > 0.0 and joules / err < REST_SHARE * lift:
                 # nothing moved (no gravity, no loading): the scale the error is divided by is noise
                 lines.append(_row("energy balance error", f"{joules:.2e}", "J", "largest, absolute: the run's energies stay "
                                   "below 1e-3 of lifting its free blocks by 1 mm, a relative error would be noise"))

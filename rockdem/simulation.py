@@ -73,7 +73,7 @@ DEFAULT_MAX_STEPS = 1_000_000_000
 
 LIFT_1MM = 9.81e-3
 """Work of lifting 1 kg by 1 mm [J/kg]: times the free mass, the least energy scale of a run (the
-divergence check's floor; below 1e-3 of it a run's energies are noise)."""
+divergence check's floor; below :data:`REST_SHARE` of it a run's energies are noise)."""
 
 
 def simulate(
@@ -451,9 +451,6 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         scratch.lost_block[:] = -1
         _warn_not_at_rest(model, state)
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
-    if start is not None and state.step[0] == 0:
-        state.velocity_lag[0] = 0.0  # the model's initial velocities are those at t = 0 (a saved state's
-        # are its last half step's: a checkpoint keeps its own lag)
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)
@@ -463,9 +460,10 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     return _Run(info, state, scratch, rec, 0, interval, snaps)
 
 
-SETTLED_KINETIC = 1e-3
-"""A state whose kinetic energy exceeds this share of the work of lifting its free blocks by 1 mm
-is not at rest: a new run started from it (--settled) is warned about."""
+REST_SHARE = 1e-3
+"""Energies below this share of :data:`LIFT_1MM` times the free mass are rest, or noise: a saved
+state with more kinetic energy that starts a new run (--settled) is warned about, and a run whose
+energies all stay below it has its balance error summarised in J."""
 
 
 def _warn_not_at_rest(model: Model, state: State) -> None:
@@ -475,7 +473,7 @@ def _warn_not_at_rest(model: Model, state: State) -> None:
     ke = 0.5 * float(np.sum(m.block_mass[free] * np.sum(state.velocity[free] ** 2, axis=1))
                      + np.sum(m.block_inertia[free] * state.omega[free] ** 2))
     lift = LIFT_1MM * float(m.block_mass[free].sum())
-    if ke > SETTLED_KINETIC * lift:
+    if ke > REST_SHARE * lift:
         warn_user(f"the saved state that starts this run at t = 0 is not at rest: kinetic energy {ke:.3g} J "
                   f"({ke / lift:.3g} x lifting its free blocks by 1 mm); the run starts with those velocities. "
                   "Settle longer (or continue that run with --from)")

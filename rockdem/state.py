@@ -97,7 +97,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         time=one.copy(),
         dt=one.copy(),
         dt_prev=one.copy(),
-        velocity_lag=one.copy(),
+        velocity_lag=one.copy(),  # 0: the initial velocities are those at t = 0 (a half step's update first)
         dt_min=one.copy(),
         safety=one.copy(),
         resolution=one.copy(),
