@@ -67,7 +67,7 @@ def run_options(case: Case, duration: float | None = None) -> dict[str, Any]:
         raise ValueError(f"[loading] delay = {delay:g} s is not before the run's end ({dur:g} s, [run] duration or "
                          "--duration): the record would never act; shorten the delay or lengthen the run")
     return {"duration": dur, "dt": r.dt, "timestep_rule": r.timestep_rule, "safety": r.safety, "resolution": r.resolution,
-            "dashpots": r.dashpots, "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
+            "impact_refinement": r.impact_refinement, "dashpots": r.dashpots, "record_interval": r.record_interval, "monitors": case.monitors, "contact_interval": r.contact_interval,
             "stop": r.stop}
 
 

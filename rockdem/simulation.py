@@ -54,9 +54,11 @@ from .stopping import Decision, Stopper, StopRule, stop_rule
 from .timestep import (
     DEFAULT_RESOLUTION,
     DEFAULT_SAFETY,
+    IMPACT_REFINEMENT,
     MAX_DAMPING_RATIO,
     TimestepInfo,
     dashpot_code,
+    impact_windows,
     resolve_dashpots,
     stable_timestep,
 )
@@ -84,6 +86,7 @@ def simulate(
     timestep_rule: str | None = None,
     safety: float | None = None,
     resolution: float | None = None,
+    impact_refinement: float | None = None,
     dashpots: str | None = None,
     record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
@@ -107,6 +110,10 @@ def simulate(
         safety: fraction of the stable bound for the automatic timestep (default 0.9).
         resolution: largest omega_max dt / 2 (default 0.3), so that impacts last several steps and
             keep their energy error below 1 % (see :mod:`rockdem.timestep`); 1 turns this limit off.
+        impact_refinement: the step is divided by this around impacts (default 6,
+            :data:`rockdem.timestep.IMPACT_REFINEMENT`; rule "bound" with implicit dashpots), so that
+            rocking under an earthquake follows the converged history (:func:`rockdem.timestep.impact_windows`);
+            1 turns the impact windows off.
         dashpots: how SP dashpots are integrated: "implicit" (trapezoidal, stable at the undamped
             step whatever beta, :mod:`rockdem.kernels.implicit`), "explicit" (on the last half step's
             velocities with Belytschko's step reduction, as 3DEC does) or "auto" (default, None:
@@ -155,7 +162,7 @@ def simulate(
             a checkpoint of another model.
     """
     out = run_model(model, duration, dt=dt, timestep_rule=timestep_rule, safety=safety, resolution=resolution,
-                    dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
+                    impact_refinement=impact_refinement, dashpots=dashpots, record_interval=record_interval, monitors=monitors, progress=progress,
                     contact_interval=contact_interval, max_steps=max_steps, stop=stop, initial=initial,
                     checkpoint=checkpoint, checkpoint_every=checkpoint_every, threads=threads)
     late: list[int] = []
@@ -212,6 +219,7 @@ def run_model(
     timestep_rule: str | None = None,
     safety: float | None = None,
     resolution: float | None = None,
+    impact_refinement: float | None = None,
     dashpots: str | None = None,
     record_interval: float | None = None,
     monitors: Mapping[str, Monitor] | None = None,
@@ -254,10 +262,10 @@ def run_model(
     with _deferred_signals(note="rockdem: stopping once the compiled kernels are loaded (a first run compiles them)"):
         if ck is None or ck.fresh:
             run = _fresh_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots, record_interval,
-                             contact_interval, max_steps, start)
+                             contact_interval, max_steps, start, impact_refinement)
         else:
             run = _continued_run(model, duration, ck, dt, timestep_rule, safety, resolution, dashpots,
-                                 record_interval, contact_interval, max_steps)
+                                 record_interval, contact_interval, max_steps, impact_refinement)
     saver = _Saver(model, run, checkpoint, checkpoint_every)
     info, state, scratch, rec, snaps = run.info, run.state, run.scratch, run.records, run.snaps
     frame, frames = run.frame, rec.time.shape[0]
@@ -336,6 +344,8 @@ def run_model(
             "omega_max": info.omega_max,
             "sp_factor": info.sp_factor,
             "resolution": info.resolution,
+            "impact_refinement": float(state.refinement[0]) if state.impact_window[0] > 0.0 else 1.0,
+            "impact_window_s": float(state.impact_window[0]),
             "timestep_rule": info.rule,
             "dashpots": info.dashpots,
             "damping_ratio": info.damping_ratio,
@@ -424,12 +434,14 @@ def _frames(model: Model, duration: float, record_interval: float) -> Records:
 
 def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float | None, rule: str | None,
                safety: float | None, resolution: float | None, dashpots: str | None, record_interval: float | None,
-               contact_interval: float | None, max_steps: int, start: Start | None = None) -> _Run:
+               contact_interval: float | None, max_steps: int, start: Start | None = None,
+               impact_refinement: float | None = None) -> _Run:
     """A run from t = 0: the model's initial state (``start``'s when given: its timestep and
     arrays, used in place), or a checkpoint's state with its clock reset."""
     interval = _positive_number("record_interval", 0.002 if record_interval is None else record_interval, "s")
     safety = DEFAULT_SAFETY if safety is None else safety
     resolution = DEFAULT_RESOLUTION if resolution is None else resolution
+    impact_refinement = IMPACT_REFINEMENT if impact_refinement is None else impact_refinement
     snaps = ContactSnapshots(model, contact_interval)
     if start is None and ck is None:
         start = prepare_start(model, timestep_rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
@@ -450,7 +462,9 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         state, scratch = ck.engine_arrays(model)
         scratch.lost_block[:] = -1
         _warn_not_at_rest(model, state)
-    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = info.dt
+    state.dt[0] = state.dt_prev[0] = state.dt_min[0] = state.dt_coarse[0] = info.dt
+    state.refinement[0], state.impact_window[0], state.impact_speed[0] = impact_windows(model, info, impact_refinement)
+    state.refine_until[0] = 0.0
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)
@@ -481,13 +495,15 @@ def _warn_not_at_rest(model: Model, state: State) -> None:
 
 def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | None, rule: str | None,
                    safety: float | None, resolution: float | None, dashpots: str | None,
-                   record_interval: float | None, contact_interval: float | None, max_steps: int) -> _Run:
+                   record_interval: float | None, contact_interval: float | None, max_steps: int,
+                   impact_refinement: float | None = None) -> _Run:
     """The run saved in ``ck``, continued to ``duration``: its state, frames and snapshots."""
     ck.check_model(model)
     given = {"dt": (dt, ck.timestep.dt if ck.timestep.rule == "user" else None),
              "timestep_rule": (rule, ck.timestep.rule if ck.timestep.rule != "user" else None),
              "safety": (safety, float(ck.state.safety[0])),
              "resolution": (resolution, float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
+             "impact_refinement": (impact_refinement, float(ck.state.refinement[0])),
              "dashpots": (None if dashpots is None else resolve_dashpots(model, dashpots), ck.timestep.dashpots),
              "record_interval": (record_interval, ck.record_interval),
              "contact_interval": (contact_interval, ck.contact_interval)}

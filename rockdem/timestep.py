@@ -17,10 +17,14 @@ undamped step for any beta (:mod:`rockdem.kernels.implicit`, ``docs/dashpots.md`
   implicit dashpots run at the resolution step, which also resolves a critically damped impact
   (e_a within 0.1 % of the converged answer on the Fig. 4 grid, ``docs/dashpots.md``).
 
-Under an earthquake the default step does not always reach WME 0.01 of the converged history
-(0.0021 to 0.18 on eight cases): rocking amplifies the scheme's second-order impact error as it
-amplifies a 1 % change of beta; :data:`QUAKE_RESOLUTION` (0.05) reaches that level at 6 times the
-steps (``docs/dashpots.md``).
+Impact windows: under an earthquake the step above does not reach WME 0.01 of the converged history
+(0.0023 to 0.18 on eight cases): rocking amplifies the scheme's second-order error, made at the
+impacts, as it amplifies a 1 % change of beta. So the kernel divides the step by
+:data:`IMPACT_REFINEMENT` (6: resolution 0.05) from one contact period before each predicted impact
+until one period after it (:func:`impact_windows`): WME 0.0001 to 0.0049 on the same eight cases for
+2 to 7 % more steps, where :data:`QUAKE_RESOLUTION` everywhere takes 6 times the steps
+(``docs/dashpots.md``). The window must open before the impact: a window opened one step into it
+did no better than none (the step's change then falls inside the impact).
 
 During the run the bound is recomputed at every contact detection and the step is lowered if
 stiffer contacts form. A block with no contact at the start (in free fall) is bounded as if all
@@ -34,6 +38,7 @@ paper's 3DEC figures.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,7 +50,8 @@ from .model import Model
 from .state import initial_state
 
 __all__ = ["TimestepInfo", "stable_timestep", "DEFAULT_SAFETY", "DEFAULT_RESOLUTION", "QUAKE_RESOLUTION",
-           "DASHPOT_SCHEMES", "resolve_dashpots", "dashpot_code", "MAX_DAMPING_RATIO"]
+           "DASHPOT_SCHEMES", "resolve_dashpots", "dashpot_code", "MAX_DAMPING_RATIO", "IMPACT_REFINEMENT",
+           "impact_windows"]
 
 DASHPOT_SCHEMES = ("auto", "implicit", "explicit")
 """How SP dashpots are integrated: "implicit" (trapezoidal, stable at the undamped step,
@@ -93,11 +99,44 @@ DEFAULT_RESOLUTION = 0.3
 
 QUAKE_RESOLUTION = 0.05
 """The resolution at which implicit-dashpot rocking under an earthquake matches the converged
-history within WME 0.01 (issue 12): measured on eight earthquake cases, worst 0.0052, against
-0.0021 to 0.18 at the default 0.3 (``benchmarks/quake_convergence.py``, ``docs/dashpots.md``). Not a
-default: it takes 6 times the steps, and the default step's error is of the size of the change a
-1 % change of beta makes to these responses (0.04 to 1.5 times it). Pass it as ``resolution`` (case
-key ``run.resolution``) where histories must agree to that level."""
+history within WME 0.01 without impact windows (issue 12): measured on eight earthquake cases, worst
+0.0052, against 0.0021 to 0.18 at the default 0.3 (``benchmarks/quake_convergence.py``,
+``docs/dashpots.md``). It takes 6 times the steps; the default impact windows
+(:data:`IMPACT_REFINEMENT`) reach the same level for a few per cent more."""
+
+
+IMPACT_REFINEMENT = 6
+"""The step inside an impact window is the run's step divided by this (resolution 0.3 -> 0.05 there):
+see :func:`impact_windows`."""
+
+MAX_IMPACT_REFINEMENT = 100.0
+"""Largest impact refinement accepted (a larger one is a typo that would make a run endless)."""
+
+IMPACT_WINDOW_PERIODS = 1.0
+"""An impact window opens this many periods 2 pi / omega_max of the stiffest contact before a
+predicted impact and closes as long after it."""
+
+IMPACT_OVERLAPS = 5.0
+"""A touch is an impact (opens a window) when its dynamic overlap v / omega_max exceeds this many
+static overlaps g / omega_max^2: closing speed v > IMPACT_OVERLAPS g / omega_max."""
+
+
+def impact_windows(model: Model, info: TimestepInfo, refinement: float = IMPACT_REFINEMENT) -> tuple[float, float, float]:
+    """(refinement, window [s], impact speed [m/s]) of a run with timestep ``info`` (window 0: none). The kernel
+    (:func:`rockdem.kernels.step.advance`) divides the step by ``refinement`` from ``window`` before an
+    unbonded sub-contact is predicted to touch at a closing speed above ``impact speed`` (its gap over
+    that speed) until ``window`` after it. The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max:
+    an impact whose dynamic overlap v / omega_max exceeds 5 static overlaps g / omega_max^2 under
+    gravity (any closing speed without gravity). Refinement 1 (and the rules "user" and "3dec", and explicit dashpots, kept as
+    3DEC's scheme) turns the windows off."""
+    if isinstance(refinement, bool) or not (isinstance(refinement, numbers.Real) and 1.0 <= refinement <= MAX_IMPACT_REFINEMENT):
+        raise ValueError(f"impact_refinement must be a number from 1 (no impact windows) to {MAX_IMPACT_REFINEMENT:g} "
+                         f"(default {IMPACT_REFINEMENT:g}), got {refinement!r}")
+    if refinement == 1.0 or info.rule != "bound" or info.dashpots != "implicit" or not info.omega_max > 0.0:
+        return float(refinement), 0.0, math.inf  # (a window of 0 never opens)
+    window = IMPACT_WINDOW_PERIODS * 2.0 * math.pi / info.omega_max
+    speed = IMPACT_OVERLAPS * float(np.linalg.norm(model.arrays.gravity)) / info.omega_max
+    return float(refinement), window, speed
 
 
 @dataclass(frozen=True)

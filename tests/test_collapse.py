@@ -25,9 +25,9 @@ sys.modules["collapse_scenarios"] = scenarios
 _spec.loader.exec_module(scenarios)
 
 
-def _impact_error(model, duration, dt=None):
+def _impact_error(model, duration, dt=None, **run):
     """Energy balance error after the impacts of an undamped run, relative to its largest KE."""
-    ds = simulate(model, duration, dt=dt, record_interval=0.002, progress=False)
+    ds = simulate(model, duration, dt=dt, record_interval=0.002, progress=False, **run)
     ke = ds.energy_kinetic.values
     return float(ds.energy_balance_error.values[-1] / ke.max()), ds
 
@@ -35,14 +35,38 @@ def _impact_error(model, duration, dt=None):
 def test_undamped_impact_energy_error_is_below_one_percent_and_converges():
     # Issue 11: the 0.5 x 0.8 m block with 2 points, no damping, high friction (no sliding): the
     # leapfrog scheme used to lose -6 to -50 % of the impact's kinetic energy without converging.
+    # Without impact windows (the step of the resolution rule throughout; the default's windows are
+    # the next test) and at a twentieth of the critical step.
     model = rocking_block(0.5, 0.8, points=(2, 2), kn=2.25e9, friction_angle=80.0)
-    err, ds = _impact_error(model, 0.8)
+    err, ds = _impact_error(model, 0.8, impact_refinement=1)
     theta = ds.rocking_angle.values[:, 1]
     assert np.any(np.diff(np.sign(theta[np.abs(theta) > 1e-4])) != 0)  # it did impact and rock back
     assert abs(err) < 0.01
     crit = stable_timestep(model).critical
     finer, _ = _impact_error(model, 0.8, dt=0.05 * crit)
     assert abs(finer) < 0.25 * abs(err) + 1e-4
+
+
+def test_impact_windows_refine_the_step_before_the_impact_and_cut_its_energy_error():
+    """The same block: the default impact window (timestep.impact_windows) opens before the edge
+    lands, so the impact is integrated at a sixth of the step (of the step the contacts lowered it
+    to), and its energy error falls below a tenth of the error without windows (measured -0.37 % ->
+    -0.014 %, for 6 % more steps)."""
+    model = rocking_block(0.5, 0.8, points=(2, 2), kn=2.25e9, friction_angle=80.0)
+    plain = simulate(model, 0.8, record_interval=0.002, progress=False, impact_refinement=1)
+    ds = simulate(model, 0.8, record_interval=0.002, progress=False)
+    assert plain.attrs["impact_refinement"] == 1.0 and ds.attrs["impact_refinement"] == 6.0
+    assert ds.attrs["dt_min"] == pytest.approx(plain.attrs["dt_min"] / 6.0, rel=1e-12)
+    assert ds.attrs["steps"] < 1.2 * plain.attrs["steps"]
+    err = [float(d.energy_balance_error.values[-1] / d.energy_kinetic.values.max()) for d in (plain, ds)]
+    assert abs(err[1]) < 0.1 * abs(err[0])
+
+
+@pytest.mark.parametrize("bad", [0.5, 1000.0, float("nan"), True, "6"])
+def test_impact_refinement_is_checked(bad):
+    model = rocking_block(0.5, 0.8, points=(2, 2))
+    with pytest.raises(ValueError, match="impact_refinement"):
+        simulate(model, 0.01, progress=False, impact_refinement=bad)
 
 
 def test_tilted_drop_conserves_energy():

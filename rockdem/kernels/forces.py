@@ -147,7 +147,7 @@ def _classify_corner(
                                x1 - s.position[o, 1], x2 - s.position[o, 2], n0, n1, n2)
             flex += flexibility(sc.rotation[t], m.block_inv_mass[t], m.block_inv_inertia[t], x0 - s.position[t, 0],
                                 x1 - s.position[t, 1], x2 - s.position[t, 2], n0, n1, n2)
-            w = 2.0 * CORNER_RESOLUTION / s.dt[0]
+            w = 2.0 * CORNER_RESOLUTION / s.dt_coarse[0]
             k = m.mat_kn[m.block_group[o], m.block_group[t]] * m.point_area[p]
             if k * flex > 0.0:
                 f = max(1.0, min(f, w * w / (k * flex)))
@@ -518,8 +518,8 @@ def _law_pass_parallel(m: ModelArrays, s: State, sc: Scratch, dt: float, implici
 def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, float, int]:
     """Add up, in pair order, what :func:`_law_pair` left per pair side: the resultants on the two
     blocks, the energies and counts, the failed bonds (``s.point_failed``), the sub-contacts that
-    opened during the last step (listed in ``sc.pending`` for :func:`_release_pass`) and the
-    detections asked for (:func:`_blend`).
+    opened during the last step (listed in ``sc.pending`` for :func:`_release_pass`), the
+    detections asked for (:func:`_blend`) and the soonest impact predicted (``sc.touch_time``).
 
     Returns (elastic energy, active count, friction and bond energy dissipated, opened count)."""
     elastic = 0.0
@@ -527,6 +527,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
     e_fric = 0.0
     e_bond = 0.0
     nrel = 0
+    touch = np.inf
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
@@ -543,6 +544,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
             active += sc.side_active[i, side]
             e_fric += sc.side_friction[i, side]
             e_bond += sc.side_bond[i, side]
+            touch = min(touch, sc.side_touch[i, side])
             f = sc.side_force[i, side]
             q = sc.side_moment[i, side]
             _apply_resultant(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f[0], f[1], f[2], q[0], q[1], q[2])
@@ -558,6 +560,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
                     sc.pending[nrel] = k
                     sc.pending_pair[nrel] = i
                     nrel += 1
+    sc.touch_time[0] = touch
     return elastic, active, e_fric, e_bond, nrel
 
 
@@ -580,6 +583,8 @@ def _law_range(
     u_side = 0.0
     released = 0
     failed = 0
+    touch = np.inf
+    impact_speed = s.impact_speed[0]
     sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = 0.0
     fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
     # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
@@ -681,6 +686,10 @@ def _law_range(
         s.slot_cover[p, j] = cover_w
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         s.slot_area[p, j] = area
+        if vn < -impact_speed and area > 0.0 and not bonded:
+            # An impact ahead (or under way): when this covered cell touches at its closing speed
+            # (the step is refined around impacts, kernels.step.advance).
+            touch = min(touch, max(-un, 0.0) / -vn)
         vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
         kna = kn * area
         ksa = ks * area
@@ -823,6 +832,7 @@ def _law_range(
     sc.side_bond[i, side] = e_bond
     sc.side_released[i, side] = released
     sc.side_failed[i, side] = failed
+    sc.side_touch[i, side] = touch
     return u_side
 
 

@@ -553,7 +553,10 @@ def advance(
     ahead, so that such a contact is tracked and bounded before it presses: without it, a
     0.25 x 1.25 m block toppling at 3.57e-4 s steps landed on its face 0.7 mm deep at the first
     step and lost 7 % of its kinetic energy unbooked (collapse_scenarios.topple_near_edge).
-    Velocities use the mean of the two step lengths.
+    Velocities use the mean of the two step lengths. Inside an impact window the step is
+    ``s.dt_coarse`` (the step the rules above lower) divided by ``s.refinement``: a window opens when
+    the force pass predicts an impact (``sc.touch_time``, forces._law_range) within
+    ``s.impact_window`` and closes that long after the predicted touch (:func:`rockdem.timestep.impact_windows`).
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
@@ -571,9 +574,9 @@ def advance(
         # work wrongly (a façade toppling with SP damping: balance 4.9 % against 2.3 %) and a
         # continuous cap created 10 % of the two-block wall's energy scale under Nahanni.
         dt_kin = kinematic_step(m, s, sc, s.time[0] + 0.5 * s.dt[0])
-        if dt_kin < s.dt[0]:
-            s.dt[0] = dt_kin
-        dt = s.dt[0]
+        if dt_kin < s.dt_coarse[0]:
+            s.dt_coarse[0] = dt_kin
+        dt = s.dt_coarse[0]
         if 2.0 * (moved + speed * dt) >= m.contact_tol or edge_pairs_changed(m, s, sc):
             detect(m, s, sc)
             if sc.overflow[0] > 0:
@@ -582,11 +585,13 @@ def advance(
                 return frame, STATUS_GROW
             dt_crit, omega, _ = contact_bound(m, s, sc, s.dashpots[0] == DASHPOTS_EXPLICIT)
             safe = min(s.safety[0] * dt_crit, s.resolution[0] * 2.0 / omega) if omega > 0.0 else np.inf
-            if safe < s.dt[0]:
-                s.dt[0] = safe
-            dt = s.dt[0]
-        s.dt_min[0] = min(s.dt_min[0], dt)
+            if safe < s.dt_coarse[0]:
+                s.dt_coarse[0] = safe
         t = s.time[0]
+        # Inside an impact window (opened by the last force pass) the step is refined.
+        dt = s.dt_coarse[0] / s.refinement[0] if t < s.refine_until[0] else s.dt_coarse[0]
+        s.dt[0] = dt
+        s.dt_min[0] = min(s.dt_min[0], dt)
         # Frames whose time is nearest to this step (k interval <= t + dt / 2, not yet recorded).
         end = frame
         while end < rec.time.shape[0] and end * record_interval <= t + 0.5 * dt:
@@ -598,6 +603,9 @@ def advance(
         h = lag + 0.5 * dt
         # Body loads at the middle of that interval (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.5 * (0.5 * dt - lag), s.dt_prev[0])
+        if sc.touch_time[0] < s.impact_window[0]:
+            # An impact within the window ahead: refine from the next step until a window past it.
+            s.refine_until[0] = max(s.refine_until[0], t + sc.touch_time[0] + s.impact_window[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT and has_dashpots(m):
             dashpot_work(m, s, sc, h)
