@@ -21,8 +21,8 @@ Impact windows: under an earthquake the step above does not reach WME 0.01 of th
 (0.0023 to 0.18 on eight cases): rocking amplifies the scheme's second-order error, made at the
 impacts, as it amplifies a 1 % change of beta. So the kernel divides the step by
 :data:`IMPACT_REFINEMENT` (6: resolution 0.05) from one contact period before each predicted impact
-until one period after it (:func:`impact_windows`): WME 0.0001 to 0.0049 on the same eight cases for
-2 to 7 % more steps, where :data:`QUAKE_RESOLUTION` everywhere takes 6 times the steps
+until two periods after it (:func:`impact_windows`): WME 0.0001 to 0.0049 on the same eight cases for
+2 to 6 % more steps, where :data:`QUAKE_RESOLUTION` everywhere takes 6 times the steps
 (``docs/dashpots.md``). The window must open before the impact: a window opened one step into it
 did no better than none (the step's change then falls inside the impact).
 
@@ -114,7 +114,7 @@ MAX_IMPACT_REFINEMENT = 100.0
 
 IMPACT_WINDOW_PERIODS = 1.0
 """An impact window opens this many periods 2 pi / omega_max of the stiffest contact before a
-predicted impact and closes as long after it."""
+predicted impact and closes twice as long after it (:data:`rockdem.kernels.step.IMPACT_AFTER`)."""
 
 IMPACT_OVERLAPS = 5.0
 """A touch is an impact (opens a window) when its dynamic overlap v / omega_max exceeds this many
@@ -122,13 +122,19 @@ static overlaps g / omega_max^2: closing speed v > IMPACT_OVERLAPS g / omega_max
 
 
 def impact_windows(model: Model, info: TimestepInfo, refinement: float = IMPACT_REFINEMENT) -> tuple[float, float, float]:
-    """(refinement, window [s], impact speed [m/s]) of a run with timestep ``info`` (window 0: none). The kernel
-    (:func:`rockdem.kernels.step.advance`) divides the step by ``refinement`` from ``window`` before an
-    unbonded sub-contact is predicted to touch at a closing speed above ``impact speed`` (its gap over
-    that speed) until ``window`` after it. The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max:
-    an impact whose dynamic overlap v / omega_max exceeds 5 static overlaps g / omega_max^2 under
-    gravity (any closing speed without gravity). Refinement 1 (and the rules "user" and "3dec", and explicit dashpots, kept as
-    3DEC's scheme) turns the windows off."""
+    """(refinement, window [s], impact speed [m/s]) of a run with timestep ``info`` (window 0: none).
+
+    The kernel (:func:`rockdem.kernels.step.advance`) divides the step by ``refinement`` from
+    ``window`` before an open unbonded sub-contact is predicted to touch (its gap over its closing
+    speed, when that speed exceeds ``impact speed``) until two windows after the touch
+    (``kernels.step.IMPACT_AFTER``). The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max: an
+    impact whose dynamic overlap v / omega_max exceeds 5 static overlaps g / omega_max^2 (any closing
+    speed without gravity). Refinement 1, the rules "user" and "3dec" and explicit dashpots (kept as
+    3DEC's scheme) have no windows.
+
+    Raises:
+        ValueError: ``refinement`` not a number from 1 to :data:`MAX_IMPACT_REFINEMENT`.
+    """
     if isinstance(refinement, bool) or not (isinstance(refinement, numbers.Real) and 1.0 <= refinement <= MAX_IMPACT_REFINEMENT):
         raise ValueError(f"impact_refinement must be a number from 1 (no impact windows) to {MAX_IMPACT_REFINEMENT:g} "
                          f"(default {IMPACT_REFINEMENT:g}), got {refinement!r}")
