@@ -55,6 +55,7 @@ from .timestep import (
     DEFAULT_RESOLUTION,
     DEFAULT_SAFETY,
     IMPACT_REFINEMENT,
+    IMPACT_SHARE,
     MAX_DAMPING_RATIO,
     TimestepInfo,
     dashpot_code,
@@ -346,6 +347,7 @@ def run_model(
             "resolution": info.resolution,
             "impact_refinement": float(state.refinement[0]) if state.impact_window[0] > 0.0 else 1.0,
             "impact_window_s": float(state.impact_window[0]),
+            "impact_window_share": float(state.refined_time[0] / state.time[0]) if state.time[0] > 0.0 else 0.0,
             "timestep_rule": info.rule,
             "dashpots": info.dashpots,
             "damping_ratio": info.damping_ratio,
@@ -464,7 +466,8 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         _warn_not_at_rest(model, state)
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = state.dt_coarse[0] = info.dt
     state.refinement[0], state.impact_window[0], state.impact_speed[0] = impact_windows(model, info, impact_refinement)
-    state.refine_until[0] = 0.0
+    state.refine_until[0] = state.refined_time[0] = 0.0
+    state.impact_share[0] = IMPACT_SHARE
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)

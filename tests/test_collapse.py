@@ -16,7 +16,8 @@ import pytest
 
 from conftest import rocking_block
 from rockdem.simulation import simulate
-from rockdem.timestep import stable_timestep
+from rockdem.kernels.step import IMPACT_AFTER
+from rockdem.timestep import IMPACT_SHARE, stable_timestep
 
 _spec = importlib.util.spec_from_file_location(
     "collapse_scenarios", Path(__file__).resolve().parents[1] / "benchmarks" / "collapse_scenarios.py"
@@ -227,6 +228,9 @@ def test_collapse_scenario(name):
     assert out.simulated_s == pytest.approx(sc.duration, abs=2 * sc.record_interval)
     assert out.overlap_relative < 0.02, f"{name}: interpenetration {out.overlap_m:.4g} m between {out.overlap_blocks}"
     assert out.energy_created <= 0.01 * out.energy_scale, f"{name}: energy created {out.energy_created:.4g} J"
+    # The impact windows stay within their budget (the last one opened may run its length past it).
+    window = ds.attrs["impact_window_s"]
+    assert ds.attrs["impact_window_share"] <= IMPACT_SHARE + (1.0 + IMPACT_AFTER) * window / sc.duration
     if name == "ridge_to_ridge":  # apart: no force, nothing moves
         assert float(np.abs(ds.block_velocity.values).max()) == 0.0
     if name == "random_pile":  # comes to rest on the ground

@@ -686,11 +686,6 @@ def _law_range(
         s.slot_cover[p, j] = cover_w
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
         s.slot_area[p, j] = area
-        if un < 0.0 and vn < -impact_speed and area > 0.0 and not bonded:
-            # An impact ahead: when this open covered cell touches at its closing speed (the step
-            # is refined around impacts, kernels.step.advance). A pressed one opens no window: the
-            # joints of a settling wall vibrate at closing speeds far above the impact speed.
-            touch = min(touch, -un / -vn)
         vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
         kna = kn * area
         ksa = ks * area
@@ -706,6 +701,11 @@ def _law_range(
             bonded = False
             prev_area = 0.0  # its energy is counted
         if opened:
+            if vn < -impact_speed and un < 0.0 and area > 0.0 and not bonded:
+                # An impact ahead: when this open covered cell touches at its closing speed (the
+                # step is refined around impacts, kernels.step.advance). A pressed one opens no
+                # window: the joints of a settling wall vibrate at closing speeds far above it.
+                touch = min(touch, -un / -vn)
             # Not in contact: the stored shear energy is lost (friction), a bond slid off breaks.
             e = 0.5 * ks * prev_area * (us0 * us0 + us1 * us1 + us2 * us2)
             if bonded:

@@ -161,6 +161,8 @@ class State(NamedTuple):
     impact_window: np.ndarray  # (1,) [s] a window opens this long before a predicted impact and lasts this long after
     impact_speed: np.ndarray  # (1,) [m/s] closing speed above which an unbonded sub-contact's touch is an impact
     refine_until: np.ndarray  # (1,) [s] end of the present impact window (<= time: none)
+    refined_time: np.ndarray  # (1,) [s] simulated time spent in impact windows so far
+    impact_share: np.ndarray  # (1,) no window opens while refined_time exceeds this share of the time
     dashpots: np.ndarray  # (1,) int64 DASHPOTS_IMPLICIT or DASHPOTS_EXPLICIT
     dashpot_sweeps: np.ndarray  # (1,) int64 Jacobi sweeps of the implicit dashpots of coupled free blocks so far
     dashpot_unconverged: np.ndarray  # (1,) int64 steps whose sweeps stopped at DASHPOT_MAX_SWEEPS

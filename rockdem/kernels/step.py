@@ -563,7 +563,8 @@ def advance(
     Velocities use the mean of the two step lengths. Inside an impact window the step is
     ``s.dt_coarse`` (the step the rules above lower) divided by ``s.refinement``: a window opens when
     the force pass predicts an impact (``sc.touch_time``, forces._law_range) within
-    ``s.impact_window`` and closes :data:`IMPACT_AFTER` windows after the predicted touch
+    ``s.impact_window`` and closes :data:`IMPACT_AFTER` windows after the predicted touch, unless
+    the windows so far (``s.refined_time``) exceed the share ``s.impact_share`` of the time
     (:func:`rockdem.timestep.impact_windows`).
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
@@ -597,7 +598,10 @@ def advance(
                 s.dt_coarse[0] = safe
         t = s.time[0]
         # Inside an impact window (opened by the last force pass) the step is refined.
-        dt = s.dt_coarse[0] / s.refinement[0] if t < s.refine_until[0] else s.dt_coarse[0]
+        dt = s.dt_coarse[0]
+        if t < s.refine_until[0]:
+            dt /= s.refinement[0]
+            s.refined_time[0] += dt
         s.dt[0] = dt
         s.dt_min[0] = min(s.dt_min[0], dt)
         # Frames whose time is nearest to this step (k interval <= t + dt / 2, not yet recorded).
@@ -611,9 +615,9 @@ def advance(
         h = lag + 0.5 * dt
         # Body loads at the middle of that interval (t itself unless the step was just lowered).
         compute_forces(m, s, sc, t + 0.5 * (0.5 * dt - lag), s.dt_prev[0])
-        if sc.touch_time[0] < s.impact_window[0]:
+        if sc.touch_time[0] < s.impact_window[0] and s.refined_time[0] <= s.impact_share[0] * t:
             # An impact within the window ahead: refine from the next step until IMPACT_AFTER
-            # windows past it.
+            # windows past it, while the windows' share of the time so far is within the budget.
             s.refine_until[0] = max(s.refine_until[0], t + sc.touch_time[0] + IMPACT_AFTER * s.impact_window[0])
         integrate_velocities(m, s, sc, t, h, rec, frame, end, dt, record_interval)
         if s.dashpots[0] == DASHPOTS_EXPLICIT and has_dashpots(m):
