@@ -561,11 +561,11 @@ def advance(
     0.25 x 1.25 m block toppling at 3.57e-4 s steps landed on its face 0.7 mm deep at the first
     step and lost 7 % of its kinetic energy unbooked (collapse_scenarios.topple_near_edge).
     Velocities use the mean of the two step lengths. Inside an impact window the step is
-    ``s.dt_coarse`` (the step the rules above lower) divided by ``s.refinement``: a window opens when
-    the force pass predicts an impact (``sc.touch_time``, forces._law_range) within
-    ``s.impact_window`` and closes :data:`IMPACT_AFTER` windows after the predicted touch, unless
-    the windows so far (``s.refined_time``) exceed the share ``s.impact_share`` of the time
-    (:func:`rockdem.timestep.impact_windows`).
+    ``s.dt_coarse`` (the step the rules above lower) divided by ``s.refinement``: a window opens (or
+    lasts longer) when the force pass predicts an impact (``sc.touch_time``, forces._law_range)
+    within ``s.impact_window`` while the windows so far (``s.refined_time``) cover at most the share
+    ``s.impact_share`` of the time, and closes :data:`IMPACT_AFTER` windows after the predicted
+    touch (:func:`rockdem.timestep.impact_windows`).
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
