@@ -32,7 +32,7 @@ from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
 from .stopping import STOP_MODES
-from .timestep import DASHPOT_SCHEMES
+from .timestep import DASHPOT_SCHEMES, IMPACT_REFINEMENT
 
 __all__ = [
     "Table",
@@ -228,7 +228,7 @@ class RunOptions:
     timestep_rule: str = "bound"
     safety: float = 0.9
     resolution: float = 0.3
-    impact_refinement: float = 6.0
+    impact_refinement: float = IMPACT_REFINEMENT
     dashpots: str = "auto"
     record_interval: float = 0.002
     contact_tolerance: float | None = None
@@ -509,7 +509,7 @@ def _run_options(top: Table) -> RunOptions:
         timestep_rule=run_t.string("timestep_rule", "bound", choices=("bound", "3dec")),
         safety=run_t.number("safety", 0.9, positive=True),
         resolution=run_t.number("resolution", 0.3, positive=True),
-        impact_refinement=run_t.number("impact_refinement", 6.0, positive=True),
+        impact_refinement=run_t.number("impact_refinement", IMPACT_REFINEMENT, positive=True),
         dashpots=run_t.string("dashpots", "auto", choices=DASHPOT_SCHEMES),
         record_interval=run_t.number("record_interval", 0.002, positive=True),
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),

@@ -48,7 +48,7 @@ from .timestep import TimestepInfo
 __all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
-FORMAT_VERSION = 8
+FORMAT_VERSION = 9
 """Version of the checkpoint file layout; a file of another version is refused. (2: the model
 hash covers ``ModelArrays.face_corner_uw``, so a version-1 file's hash would not match. 3: the
 state holds ``slot_stiffening`` and ``slot_updates``, the model ``point_corner``. 5: the state

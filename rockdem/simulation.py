@@ -55,7 +55,6 @@ from .timestep import (
     DEFAULT_RESOLUTION,
     DEFAULT_SAFETY,
     IMPACT_REFINEMENT,
-    IMPACT_SHARE,
     MAX_DAMPING_RATIO,
     TimestepInfo,
     dashpot_code,
@@ -467,7 +466,6 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = state.dt_coarse[0] = info.dt
     state.refinement[0], state.impact_window[0], state.impact_speed[0] = impact_windows(model, info, impact_refinement)
     state.refine_until[0] = state.refined_time[0] = 0.0
-    state.impact_share[0] = IMPACT_SHARE
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)

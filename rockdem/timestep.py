@@ -45,6 +45,7 @@ import numpy as np
 
 from .kernels.bound import contact_bound
 from .kernels.contact import sp_critical_factor
+from .kernels.step import IMPACT_SHARE
 from .kernels.layout import DASHPOTS_EXPLICIT, DASHPOTS_IMPLICIT, Scratch, State
 from .model import Model
 from .state import initial_state
@@ -108,13 +109,6 @@ history within WME 0.01 without impact windows (issue 12): measured on eight ear
 IMPACT_REFINEMENT = 6
 """The step inside an impact window is the run's step divided by this (resolution 0.3 -> 0.05 there):
 see :func:`impact_windows`."""
-
-IMPACT_SHARE = 0.03
-"""No impact window opens while the windows so far cover more than this share of the simulated
-time: isolated impacts (a block rocking under an earthquake: 1 to 2 % of the time in windows) are
-refined; in a collapse whose debris impacts one another without pause the refinement would buy
-nothing for its cost (a weak parapet under El Centro x3: 3.2 times the steps), which the share
-bounds to 1 + 0.03 (refinement - 1) = 1.15 times."""
 
 MAX_IMPACT_REFINEMENT = 100.0
 """Largest impact refinement accepted (a larger one is a typo that would make a run endless)."""

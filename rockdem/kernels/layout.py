@@ -158,11 +158,10 @@ class State(NamedTuple):
     resolution: np.ndarray  # (1,) largest omega_max dt / 2 when the step is lowered (impact resolution)
     dt_coarse: np.ndarray  # (1,) [s] the step outside impact windows (lowered, never raised, by the bounds)
     refinement: np.ndarray  # (1,) the step inside an impact window is dt_coarse / refinement (1: no windows)
-    impact_window: np.ndarray  # (1,) [s] a window opens this long before a predicted impact and lasts this long after
+    impact_window: np.ndarray  # (1,) [s] a window opens this long before a predicted impact (0: never; step.IMPACT_AFTER)
     impact_speed: np.ndarray  # (1,) [m/s] closing speed above which an unbonded sub-contact's touch is an impact
     refine_until: np.ndarray  # (1,) [s] end of the present impact window (<= time: none)
     refined_time: np.ndarray  # (1,) [s] simulated time spent in impact windows so far
-    impact_share: np.ndarray  # (1,) no window opens while refined_time exceeds this share of the time
     dashpots: np.ndarray  # (1,) int64 DASHPOTS_IMPLICIT or DASHPOTS_EXPLICIT
     dashpot_sweeps: np.ndarray  # (1,) int64 Jacobi sweeps of the implicit dashpots of coupled free blocks so far
     dashpot_unconverged: np.ndarray  # (1,) int64 steps whose sweeps stopped at DASHPOT_MAX_SWEEPS
@@ -271,7 +270,7 @@ class Scratch(NamedTuple):
     side_active: np.ndarray  # (P, 2) int64 active sub-contacts
     side_released: np.ndarray  # (P, 2) int64 sub-contacts that opened during the last step
     side_failed: np.ndarray  # (P, 2) int64 bonds that failed at this step
-    side_touch: np.ndarray  # (P, 2) [s] soonest impact predicted on the side (gap / closing speed, 0 pressing), inf none
+    side_touch: np.ndarray  # (P, 2) [s] soonest impact predicted on the side (an open sub-contact's gap / closing speed), inf none
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
     blend_point_owner: np.ndarray  # (P, 3) [m] ... at this point (minus it on the target's block)
     blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block
