@@ -1,7 +1,8 @@
 """Convex polyhedral block geometry: hulls, faces, mass properties and interface points.
 
 Everything here is plain NumPy/SciPy and runs once, when a model is built. Units are SI: lengths in
-metres, density in kg/m^3, mass in kg, inertia in kg*m^2.
+metres, density in kg/m^3, mass in kg, inertia in kg*m^2. Boxes are built directly; other shapes go
+through Qhull (``scipy.spatial``, imported only then: a quarter of a warm ``rockdem run``).
 """
 
 from __future__ import annotations
@@ -11,7 +12,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import ConvexHull, QhullError
 
 __all__ = [
     "Polyhedron",
@@ -113,6 +113,8 @@ def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
     scale = float(np.max(np.ptp(v, axis=0)))
     if scale <= 0.0:
         raise ValueError(f"{name}: all vertices coincide; give a block of positive size")
+    from scipy.spatial import ConvexHull, QhullError  # noqa: PLC0415 - only for shapes other than boxes
+
     try:
         hull = ConvexHull(v)
     except QhullError as exc:
@@ -191,7 +193,22 @@ def box(b: float, l: float, h: float, *, center: ArrayLike = (0.0, 0.0, 0.0), na
     if c.shape != (3,) or not np.all(np.isfinite(c)):
         raise ValueError(f"{name}: center must be a finite point (x, y, z) [m], got {center!r}")
     signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    return convex_hull(c + 0.5 * signs * np.array([b, l, h]), name=name)
+    vertices = c + 0.5 * signs * np.array([b, l, h])
+    normals = np.zeros((6, 3))
+    for k, (axis, side) in enumerate(_BOX_PLANES):
+        normals[k, axis] = side
+    offsets = np.array([normals[k] @ vertices[f[0]] for k, f in enumerate(_BOX_FACES)])
+    return Polyhedron(vertices, tuple(np.array(f, dtype=np.int64) for f in _BOX_FACES), normals, offsets)
+
+
+_BOX_PLANES = ((2, -1.0), (1, -1.0), (0, 1.0), (0, -1.0), (1, 1.0), (2, 1.0))
+"""(axis, outward sign) of a box's faces, in the order Qhull gives them (-z, -y, +x, -x, +y, +z)."""
+
+_BOX_FACES = ((0, 2, 6, 4), (0, 4, 5, 1), (4, 6, 7, 5), (0, 1, 3, 2), (2, 3, 7, 6), (1, 5, 7, 3))
+"""A box's faces: indices of its vertices (vertex 4 sx + 2 sy + sz at the corner with signs s of
+(x, y, z), 0 for -1, 1 for +1), counter-clockwise seen from outside, each from its lowest index.
+:func:`convex_hull` gives the same faces in the same order, but starts some of them at another
+vertex, depending on the round-off of Qhull's normals (eight variants over random boxes)."""
 
 
 def mass_properties(poly: Polyhedron, density: float) -> MassProperties:

@@ -37,6 +37,41 @@ def test_hull_merges_coplanar_faces_and_drops_edge_midpoints():
     assert len(poly.vertices) == 8
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_box_is_the_hull_of_its_corners(seed):
+    # Boxes are built directly (no Qhull): against Qhull's hull of the same corners, the same
+    # vertices, planes (normals and offsets bit for bit) and faces in the same order, each the
+    # same cycle up to its first vertex, counter-clockwise seen from outside.
+    rng = np.random.default_rng(seed)
+    for _ in range(200):
+        dims = rng.uniform(1e-3, 10.0, 3) ** rng.choice([1.0, 2.0])
+        p = box(*dims, center=rng.uniform(-50.0, 50.0, 3))
+        q = convex_hull(p.vertices)
+        np.testing.assert_array_equal(p.vertices, q.vertices)
+        np.testing.assert_array_equal(p.normals, q.normals)
+        np.testing.assert_array_equal(p.offsets, q.offsets)
+        assert len(p.faces) == len(q.faces) == 6
+        for f, g, n, d in zip(p.faces, q.faces, p.normals, p.offsets):
+            assert any(np.array_equal(np.roll(g, r), f) for r in range(4)), (f, g)
+            v = p.vertices[f]
+            np.testing.assert_allclose(v @ n, d, rtol=0, atol=1e-12 * np.abs(p.vertices).max())
+            area_normal = 0.5 * sum(np.cross(v[k], v[(k + 1) % 4]) for k in range(4))
+            assert area_normal @ n > 0.0  # counter-clockwise seen from outside
+
+
+def test_building_boxes_does_not_import_qhull():
+    # scipy.spatial (Qhull) is a quarter of a warm `rockdem run`: models of boxes do not need it.
+    import subprocess
+    import sys
+
+    code = ("import sys; from rockdem.model import ModelBuilder; from rockdem.materials import JointMaterial; "
+            "b = ModelBuilder(); b.default_material = JointMaterial.from_modulus(1.8e9, 2.0); "
+            "b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True); b.add_box(0.2, 1, 2); b.finalize(); "
+            "print('scipy.spatial' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "False"
+
+
 @pytest.mark.parametrize("n_across,n_along", [(1, 1), (2, 2), (3, 2), (10, 4), (15, 2)])
 def test_interface_point_areas_sum_to_face_area(n_across, n_along):
     poly = box(0.2, 1.0, 2.0)

@@ -176,6 +176,30 @@ def test_save_computes_a_result_held_as_dask_arrays(tmp_path):
     xr.testing.assert_identical(load(tmp_path / "chunked.nc"), load(tmp_path / "plain.nc"))
 
 
+def test_building_a_result_does_not_import_dask_array_and_dask_arrays_still_work(tmp_path):
+    # xarray imports dask.array (0.2 to 0.7 s) at its first Variable wherever dask is installed;
+    # rockdem's record of dask resolves its array type only once dask.array is imported.
+    pytest.importorskip("dask")
+    import subprocess
+    import sys
+
+    code = ("import sys; import xarray as xr; from rockdem.results import save, load; "
+            "from rockdem.model import ModelBuilder; from rockdem.materials import JointMaterial; "
+            "from rockdem.simulation import simulate; "
+            "b = ModelBuilder(); b.default_material = JointMaterial.from_modulus(1.8e9, 2.0); "
+            "b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True); b.add_box(0.2, 1, 2); "
+            "ds = simulate(b.finalize(), 0.01, progress=False); "
+            f"save(ds, {str(tmp_path / 'a.nc')!r}); r = load({str(tmp_path / 'a.nc')!r}); "
+            "print('dask.array' in sys.modules, int((r.contacts_active * 0 + 2).sum()) == 2 * r.sizes['time']); "
+            "import dask.array as da; from xarray.namedarray.pycompat import array_type; "
+            "c = xr.Dataset({'x': ('time', da.arange(4.0, chunks=2))}); "
+            "print(array_type('dask') == (da.Array,), isinstance(c.x.data, da.Array), c.x.chunks, float(c.x.sum()))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+    first, second = out.stdout.strip().splitlines()[-2:]
+    assert first == "False True"
+    assert second == "True True ((2, 2),) 6.0"
+
+
 def test_save_replaces_a_symlink_instead_of_writing_through_it(tmp_path):
     ds = _small_result()
     target = tmp_path / "elsewhere.txt"
