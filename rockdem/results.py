@@ -77,6 +77,9 @@ from .kernels.layout import (
     Records,
 )
 
+from .kernels.rotation import quats_to_matrices, rotation_vector
+from .model import Model
+
 
 class _DaskWhenImported:
     """xarray's record of dask as a duck-array library (``xarray.namedarray.pycompat``), resolved
@@ -127,8 +130,6 @@ def _defer_dask_type() -> None:
 
 
 _defer_dask_type()
-from .kernels.rotation import quats_to_matrices, rotation_vector
-from .model import Model
 
 __all__ = [
     "EnergyCheck",
