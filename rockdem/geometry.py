@@ -181,6 +181,16 @@ def _drop_collinear(v: NDArray[np.float64], order: NDArray[np.int64], tol: float
     return np.array(keep, dtype=np.int64)
 
 
+_BOX_PLANES = ((2, -1.0), (1, -1.0), (0, 1.0), (0, -1.0), (1, 1.0), (2, 1.0))
+"""(axis, outward sign) of a box's faces, in the order Qhull gives them (-z, -y, +x, -x, +y, +z)."""
+
+_BOX_FACES = ((0, 2, 6, 4), (0, 4, 5, 1), (4, 6, 7, 5), (0, 1, 3, 2), (2, 3, 7, 6), (1, 5, 7, 3))
+"""A box's faces: indices of its vertices (vertex 4 sx + 2 sy + sz at the corner with signs s of
+(x, y, z), 0 for -1, 1 for +1), counter-clockwise seen from outside, each from its lowest index.
+:func:`convex_hull` gives the same faces in the same order, but starts some of them at another
+vertex, depending on the round-off of Qhull's normals (eight variants over random boxes)."""
+
+
 def box(b: float, l: float, h: float, *, center: ArrayLike = (0.0, 0.0, 0.0), name: str = "box") -> Polyhedron:
     """Rectangular box of width ``b`` (x), length ``l`` (y) and height ``h`` (z) [m], centred at ``center``."""
     for field, val in (("b (width, x)", b), ("l (length, y)", l), ("h (height, z)", h)):
@@ -199,16 +209,6 @@ def box(b: float, l: float, h: float, *, center: ArrayLike = (0.0, 0.0, 0.0), na
         normals[k, axis] = side
     offsets = np.array([normals[k] @ vertices[f[0]] for k, f in enumerate(_BOX_FACES)])
     return Polyhedron(vertices, tuple(np.array(f, dtype=np.int64) for f in _BOX_FACES), normals, offsets)
-
-
-_BOX_PLANES = ((2, -1.0), (1, -1.0), (0, 1.0), (0, -1.0), (1, 1.0), (2, 1.0))
-"""(axis, outward sign) of a box's faces, in the order Qhull gives them (-z, -y, +x, -x, +y, +z)."""
-
-_BOX_FACES = ((0, 2, 6, 4), (0, 4, 5, 1), (4, 6, 7, 5), (0, 1, 3, 2), (2, 3, 7, 6), (1, 5, 7, 3))
-"""A box's faces: indices of its vertices (vertex 4 sx + 2 sy + sz at the corner with signs s of
-(x, y, z), 0 for -1, 1 for +1), counter-clockwise seen from outside, each from its lowest index.
-:func:`convex_hull` gives the same faces in the same order, but starts some of them at another
-vertex, depending on the round-off of Qhull's normals (eight variants over random boxes)."""
 
 
 def mass_properties(poly: Polyhedron, density: float) -> MassProperties:

@@ -108,7 +108,7 @@ def _allocate(model: Model) -> tuple[State, Scratch]:
         impact_speed=np.full(1, np.inf),
         refine_until=one.copy(),
         refined_time=one.copy(),
-                dashpots=np.zeros(1, dtype=np.int64),
+        dashpots=np.zeros(1, dtype=np.int64),
         dashpot_sweeps=np.zeros(1, dtype=np.int64),
         dashpot_unconverged=np.zeros(1, dtype=np.int64),
         step=np.zeros(1, dtype=np.int64),
