@@ -355,6 +355,29 @@ def _mid_relative_velocity(
 
 
 @njit(cache=True, _nrt=False)
+def driven_dashpot_forces(m: ModelArrays, s: State, sc: Scratch) -> None:
+    """``sc.driven_dashpot[b]``: the resultant force [N] of the SP dashpots (``sc.dashpot_force``,
+    ``sc.pair_dashpot_force``, complete: after :func:`finalize` under implicit dashpots) on each
+    driven block b, the part of its force whose work its dissipation counts (kernels.step)."""
+    for b in range(m.block_mass.shape[0]):
+        if not m.block_free[b]:
+            for c in range(3):
+                sc.driven_dashpot[b, c] = 0.0
+    for i in range(s.pair_count[0]):
+        edge, a, b, k0, k1, split = _pair_range(m, s, i)
+        if m.block_free[a] and m.block_free[b]:
+            continue
+        for k in range(k0, k1):
+            fd = sc.pair_dashpot_force[i] if edge else sc.dashpot_force[k]
+            o, t = (a, b) if k < split else (b, a)  # fd acts on o, -fd on t
+            for c in range(3):
+                if not m.block_free[o]:
+                    sc.driven_dashpot[o, c] += fd[c]
+                if not m.block_free[t]:
+                    sc.driven_dashpot[t, c] -= fd[c]
+
+
+@njit(cache=True, _nrt=False)
 def finalize(m: ModelArrays, s: State, sc: Scratch, h: float) -> float:
     """The dashpot forces at the mid-step velocities, f = -C (v_rel- + v_rel+) / 2 (the new
     velocities in the state): stored in ``sc.dashpot_force`` / ``sc.pair_dashpot_force``, with the

@@ -181,6 +181,9 @@ class State(NamedTuple):
     # forces.cover_change, its cover grew under load; forces._hand_over_face, it took over from an edge spring)
     slot_cover: np.ndarray  # (np, SLOTS) [-] cover weight of a partly covered cell at the last force pass
     # (kernels.faces.partly_covered; 0 wholly covered): its change at a pose is a cover change (forces.cover_change)
+    slot_anchor: np.ndarray  # (np, SLOTS, 2) [m] (u, w) owner face coordinates of the point a partly covered
+    # cell's overlap is measured at (its own, or the nearest covered one), at the last force pass where slot_cover > 0
+    slot_deepest: np.ndarray  # (np, SLOTS, 2) [m] (u, w) its deepest covered vertex, likewise
     slot_bonded: np.ndarray  # (np, SLOTS) bool
     slot_stiffening: np.ndarray  # (np, SLOTS) [-] area factor of a corner that landed alone (vertex-face contact), 1 otherwise
     point_failed: np.ndarray  # (np,) int64 FAILED_*
@@ -285,6 +288,8 @@ class Scratch(NamedTuple):
     block_iterate: np.ndarray  # (2, nb, 6) velocity (world) and angular velocity (body) iterates (Jacobi sweeps)
     block_damped: np.ndarray  # (nb,) bool the block has an active dashpot this step
     driven_velocity_last: np.ndarray  # (nb, 3) [m/s] a driven block's velocity over the last step (implicit dashpots, driven work)
+    driven_force_last: np.ndarray  # (nb, 3) [N] the force on a driven block at the last step, less its dashpots' (driven work)
+    driven_dashpot: np.ndarray  # (nb, 3) [N] the SP dashpots' resultant force on a driven block at this step
     omega_mid: np.ndarray  # (nb, 3) [rad/s] step mid-point angular velocity, world
     poly: np.ndarray  # (2, 32, 2) two polygon buffers for clipping (source and destination alternate)
     chunk_poly: np.ndarray  # (LAW_CHUNKS, 2, 32, 2) the same for each chunk of the parallel law pass
