@@ -273,10 +273,10 @@ def partly_covered(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
     lumped: bool, target_cell_area: float, mask: int,
-) -> tuple[float, float, float, float, float, float, float, float, float, float]:
-    """Effective area, force point (u, w), depth shift, cover weight, depth gain, anchor (u, w) and
-    deepest covered vertex (u, w) of a cell the target polygon does not wholly cover (clipped by
-    the target's edge lines in ``mask``, :func:`crossing_lines`); points in owner face coordinates [m].
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """Effective area, force point (u, w), depth shift, cover weight, anchor (u, w) and deepest
+    covered vertex (u, w) of a cell the target polygon does not wholly cover (clipped by the
+    target's edge lines in ``mask``, :func:`crossing_lines`); points in owner face coordinates [m].
 
     The force point: from the point p (or the nearest covered point q when p is off the target)
     towards the deepest covered vertex d, by w phi'(g): w the cover weight (how much of the cell is
@@ -287,8 +287,8 @@ def partly_covered(
     point (for fixed w, q and d): the spring is then the gradient of its energy kn A u^2 / 2 and
     conserves energy as the block rocks. (The overlap at the force point, u_p + w phi'(g) g, is
     deeper by up to w tau / 2, and made a block tipping over an edge gain energy.) Returns the shift
-    u - overlap at the force point (<= 0), the cover weight w [-], the gain phi(g) [m] (0 where
-    the force point stays at p), the anchor (p, or q when p is off the target) and d. As the cover
+    u - overlap at the force point (<= 0), the cover weight w [-], the anchor (p, or q when p is
+    off the target) and d (:func:`anchored_overlap` gives u from them). As the cover
     slides, w, the anchor and d move, and with them u at a fixed pose, which the joint law treats
     as a cover change (:func:`rockdem.kernels.forces.cover_change`, :func:`anchored_overlap`).
 
@@ -327,7 +327,6 @@ def partly_covered(
     yu, yw = nu, nw
     shift = 0.0
     cover_w = 0.0
-    phi = 0.0
     au, aw, eu, ew = nu, nw, nu, nw
     if area > 0.0:
         # The force point of a partly covered cell: from the point itself (or the nearest covered
@@ -355,7 +354,6 @@ def partly_covered(
         wgt = slope * cover_w
         if gain > 0.0:  # u_p + w phi(g) minus the overlap at the force point, u_p + w phi'(g) g
             shift = -cover_w * min(gain, touch_tol) ** 2 / (2.0 * touch_tol)
-            phi = gain * gain / (2.0 * touch_tol) if gain < touch_tol else gain - 0.5 * touch_tol
         if not (node_in and wgt == 0.0):
             tu = nu_ + wgt * (du_ - nu_) - fm.t0
             tw = nw_ + wgt * (dw_ - nw_) - fm.t1
@@ -369,7 +367,7 @@ def partly_covered(
         if lumped and _straddles(cell_start, cell_vertex, p, fm):
             # (A cell wholly on one side of the target plane has the lumped area of its covered part.)
             area = max(area, min(_lumped_area(cell_start, cell_vertex, buf, cur, n, point_area, area, p, fm, gu, gw), target_cell_area))
-    return area, yu, yw, shift, cover_w, phi, au, aw, eu, ew
+    return area, yu, yw, shift, cover_w, au, aw, eu, ew
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -410,10 +408,10 @@ def cut_cell(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, ft: int, fm: FaceMap, grow: float,
     mask: int, lumped: bool, target_cell_area: float, open_before: bool = False,
-) -> tuple[float, float, float, float, float, float, float, float, float, float]:
-    """Effective area, force point (u, w), depth shift, cover weight, depth gain, anchor (u, w) and
-    deepest covered vertex (u, w) (those of :func:`partly_covered`; no shift, weight and gain, and
-    the node as anchor and vertex, for a cell wholly covered or not at all) of point p's cell (node (nu, nw), area
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """Effective area, force point (u, w), depth shift, cover weight, anchor (u, w) and
+    deepest covered vertex (u, w) (those of :func:`partly_covered`; no shift and weight, and the
+    node as anchor and vertex, for a cell wholly covered or not at all) of point p's cell (node (nu, nw), area
     ``point_area``) against target face ``ft`` grown by ``grow`` [m], tested against the target
     edge lines of ``mask`` (:func:`crossing_lines`, or ALL_LINES): :func:`covered`, then
     :func:`partly_covered` (``lumped``, ``target_cell_area`` as there) where the cell is cut.
@@ -421,7 +419,7 @@ def cut_cell(
 
     ``open_before``: the sub-contact is unbonded and was open at the last step. If no vertex of its
     cell is below the target plane, no point of it overlaps whatever the cover (the overlap is
-    affine in the cell), so it stays open and carries nothing: (0, nu, nw, 0, 0, 0, nu, nw, nu, nw) is returned without
+    affine in the cell), so it stays open and carries nothing: (0, nu, nw, 0, 0, nu, nw, nu, nw) is returned without
     clipping (the area of an open unbonded sub-contact is not used). In a settled wall this is about
     40 % of the cut cells: the head faces of diagonal neighbours, overlapping the next face by a
     sliver of the settlement difference, about half of them just apart."""
@@ -430,12 +428,12 @@ def cut_cell(
         for k in range(cell_start[p], cell_start[p + 1]):
             above = above and fm.h0 + fm.hu * cell_vertex[k, 0] + fm.hw * cell_vertex[k, 1] >= 0.0
         if above:
-            return 0.0, nu, nw, 0.0, 0.0, 0.0, nu, nw, nu, nw
+            return 0.0, nu, nw, 0.0, 0.0, nu, nw, nu, nw
     state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, grow, mask)
     if state == COVER_FULL:
-        return point_area, nu, nw, 0.0, 0.0, 0.0, nu, nw, nu, nw
+        return point_area, nu, nw, 0.0, 0.0, nu, nw, nu, nw
     if state == COVER_NONE:
-        return 0.0, nu, nw, 0.0, 0.0, 0.0, nu, nw, nu, nw
+        return 0.0, nu, nw, 0.0, 0.0, nu, nw, nu, nw
     return partly_covered(
         cell_start, cell_vertex, line_start, line, buf, nu, nw, point_area, touch_tol, p, ft, fm, grow,
         lumped, target_cell_area, mask,
@@ -452,7 +450,7 @@ def cover(m: ModelArrays, sc: Scratch, p: int, ft: int, fm: FaceMap, grow: float
     taking only the arrays they use: Numba compiles such small functions far better than one
     taking the whole model and scratch tuples, 50 ns instead of 1 us per sub-contact.)
     """
-    area, yu, yw, shift, _, _, _, _, _, _ = cut_cell(
+    area, yu, yw, shift, _, _, _, _, _ = cut_cell(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly,
         m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, grow, ALL_LINES, False, np.inf,
     )

@@ -586,7 +586,7 @@ def _open_cell_touch(
     at its present closing speed, if that speed exceeds ``impact_speed``; +inf otherwise. A face
     landing across its partner's edge is seen by these cells only (docs/dashpots.md). Out of line,
     called only while a partly covered pair may close that fast (:func:`_closing_bound`)."""
-    area, yu, yw, shift, _, _, _, _, _, _ = cut_cell(
+    area, yu, yw, shift, _, _, _, _, _ = cut_cell(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
         m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
         True, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]), False,
@@ -653,7 +653,7 @@ def _law_range(
             full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
         else:
             unbonded = not s.slot_bonded[p, j]
-            full_area, yu, yw, shift, cover_w, _, au, aw, eu, ew = cut_cell(
+            full_area, yu, yw, shift, cover_w, au, aw, eu, ew = cut_cell(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),

@@ -155,11 +155,13 @@ def integrate_velocities(
     else:
         vg[:] = 0.0
     vd = sc.driven_velocity
+    moving = False  # a driven block has a motion: only such blocks do work
     for b in range(nb):
         if m.block_free[b]:
             continue
         k = m.block_motion[b]
         if k >= 0:
+            moving = True
             interpolate(m.motion_time, m.motion_velocity, m.motion_start[k], m.motion_start[k + 1], t + 0.5 * step, vd)
         else:
             vd[:] = 0.0
@@ -268,7 +270,7 @@ def integrate_velocities(
             ke += e3
             pe += e4
         s.energy[E_DAMPING_STIFFNESS] += finalize(m, s, sc, dt)
-    dashpots = has_dashpots(m)
+    dashpots = moving and has_dashpots(m)  # (a fixed block's force does no work: its split is not needed)
     if dashpots:
         driven_dashpot_forces(m, s, sc)
     w_drv = 0.0
