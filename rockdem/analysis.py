@@ -25,6 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 from ._warn import warn_user
 
 __all__ = [
+    "rocking_direction",
+    "ground_acceleration",
     "HalfCyclePeaks",
     "Restitution",
     "Bouncing",
@@ -569,6 +571,27 @@ def summarize(
         out["bounces"] = int(len(bo.magnitude))
         out["bounce_max_m_s"] = bo.max_magnitude
     return out
+
+
+def rocking_direction(ds: Any) -> np.ndarray:
+    """Unit horizontal direction (3,) in which a positive rocking angle moves the top: axis x up."""
+    axis = np.asarray(ds.attrs.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)
+    g = np.asarray(ds.attrs.get("gravity", (0.0, 0.0, -9.81)), dtype=float)
+    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
+    d = np.cross(axis, up)
+    return d / np.linalg.norm(d)
+
+
+def ground_acceleration(ds: Any) -> np.ndarray | None:
+    """Input ground acceleration (T,) [m/s^2] of an earthquake result along the rocking direction
+    (the horizontal magnitude when the record acts across it), or None for other results."""
+    if "ground_acceleration" not in ds:
+        return None
+    a = np.asarray(ds.ground_acceleration.values, dtype=float)
+    along = a @ rocking_direction(ds)
+    if np.max(np.abs(along), initial=0.0) < 1e-6 * max(float(np.max(np.abs(a), initial=0.0)), 1e-300):
+        return np.linalg.norm(a[:, :2], axis=1)
+    return along
 
 
 def lowest_point_height(ds: Any, block: int) -> NDArray[np.float64] | None:

@@ -239,6 +239,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as exc:  # a Ctrl-C while the command's modules load, before it runs
         print(f"rockdem: stopped by {signal.Signals(exit_status(exc) - 128).name} while starting", file=sys.stderr)
         return exit_status(exc)
+    finally:
+        if "rockdem.rocking_plot" in sys.modules:  # a plotting process the command did not take
+            sys.modules["rockdem.rocking_plot"].PlotProcess.discard_early()
     if argv is None:
         gc.freeze()
     return status
@@ -247,10 +250,15 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else argv
     program = argv is None
+    command = next((w for w in words if not w.startswith("-")), None)  # top-level flags take no value
+    if program and command == "run" and "--no-plot" not in words and not {"-h", "--help"} & set(words):
+        from .rocking_plot import PlotProcess
+
+        PlotProcess.start_early()  # it imports Matplotlib while this process imports the rest and runs
     if program:
         gc.disable()  # the imports' objects live to the end: no collections over them as they load
     try:
-        parser = build_parser(next((w for w in words if not w.startswith("-")), None))  # top-level flags take no value
+        parser = build_parser(command)
     finally:
         if program:
             gc.freeze()

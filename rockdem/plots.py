@@ -31,6 +31,8 @@ from matplotlib import rc_context
 from matplotlib.figure import Figure
 
 from .analysis import (
+    ground_acceleration,
+    rocking_direction,
     apparent_restitution,
     bouncing,
     half_cycle_peaks,
@@ -41,6 +43,7 @@ from .analysis import (
     wme,
 )
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices
+from .style import STYLE, InlineFigure, save_figure
 
 __all__ = [
     "STYLE",
@@ -69,36 +72,7 @@ __all__ = [
 
 Result = xr.Dataset | str | Path
 
-STYLE: dict[str, object] = {
-    "font.family": "DejaVu Sans",
-    "font.size": 9.0,
-    "axes.titlesize": 10.0,
-    "axes.labelsize": 9.0,
-    "legend.fontsize": 8.0,
-    "axes.grid": True,
-    "grid.alpha": 0.3,
-    "lines.linewidth": 1.2,
-    "figure.dpi": 100.0,
-    "savefig.dpi": 100.0,
-    "path.simplify": False,
-    "svg.hashsalt": "rockdem",
-}
-"""Fixed Matplotlib settings (fonts, sizes, dpi) so that images are reproducible."""
-
 _WIDTH = 7.0  # figure width [in]
-
-
-class InlineFigure(Figure):
-    """A Matplotlib figure that a notebook displays inline as a cell's value, without a prior
-    ``import matplotlib.pyplot`` or ``%matplotlib inline`` (IPython calls :meth:`_repr_png_`)."""
-
-    def _repr_png_(self) -> bytes:
-        import io
-
-        buf = io.BytesIO()
-        with rc_context(STYLE):
-            self.savefig(buf, format="png", dpi=STYLE["savefig.dpi"], bbox_inches="tight")
-        return buf.getvalue()
 
 
 def _styled(func: Callable[..., Figure]) -> Callable[..., Figure]:
@@ -183,15 +157,6 @@ def _monitor(ds: xr.Dataset, monitor: str | None) -> int | None:
     if monitor not in names:
         raise ValueError(f"monitor {monitor!r} not in the result; recorded monitors are {names}")
     return names.index(monitor)
-
-
-def rocking_direction(ds: xr.Dataset) -> np.ndarray:
-    """Unit horizontal direction (3,) in which a positive rocking angle moves the top: axis x up."""
-    axis = np.asarray(ds.attrs.get("rocking_axis", (0.0, 1.0, 0.0)), dtype=float)
-    g = np.asarray(ds.attrs.get("gravity", (0.0, 0.0, -9.81)), dtype=float)
-    up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
-    d = np.cross(axis, up)
-    return d / np.linalg.norm(d)
 
 
 def _reference_rotation(ds: xr.Dataset, b: int) -> np.ndarray:
@@ -315,18 +280,6 @@ def plot_history(
     fig.align_ylabels()
     fig.tight_layout()
     return fig
-
-
-def ground_acceleration(ds: xr.Dataset) -> np.ndarray | None:
-    """Input ground acceleration (T,) [m/s^2] of an earthquake result along the rocking direction
-    (the horizontal magnitude when the record acts across it), or None for other results."""
-    if "ground_acceleration" not in ds:
-        return None
-    a = np.asarray(ds.ground_acceleration.values, dtype=float)
-    along = a @ rocking_direction(ds)
-    if np.max(np.abs(along), initial=0.0) < 1e-6 * max(float(np.max(np.abs(a), initial=0.0)), 1e-300):
-        return np.linalg.norm(a[:, :2], axis=1)
-    return along
 
 
 @_styled
@@ -633,17 +586,6 @@ PLOTS: dict[str, Callable[..., Figure]] = {
     "comparison": plot_comparison,
 }
 """Plot kinds of ``rockdem plot --kind``."""
-
-
-def save_figure(fig: Figure, path: str | Path, *, dpi: float | None = None) -> Path:
-    """Write a figure as PNG or PDF (by suffix) with the fixed style; returns the path."""
-    p = Path(path)
-    if p.suffix.lower() not in (".png", ".pdf"):
-        raise ValueError(f"output {p}: the suffix must be .png or .pdf")
-    p.parent.mkdir(parents=True, exist_ok=True)
-    with rc_context(STYLE):
-        fig.savefig(p, dpi=dpi or STYLE["savefig.dpi"], metadata={"Software": None} if p.suffix == ".png" else None)
-    return p
 
 
 # -- CLI ----------------------------------------------------------------------------------------

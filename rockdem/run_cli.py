@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import shlex
@@ -21,6 +22,7 @@ from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, pos
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
 from .loading import EQUILIBRIUM_TOLERANCE, load_carried
 from .results import export_csv, save, write_contact_table
+from .rocking_plot import PlotProcess, draw_rocking, rocking_series
 from .simulation import LIFT_1MM, REST_SHARE, _deferred_signals, simulate
 from .stopping import STOP_MODES
 
@@ -245,38 +247,7 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
 def plot_rocking(ds: xr.Dataset, path: Path) -> Path:
     """Rotation and top displacement versus time (and the input motion of an earthquake run),
     saved as PNG."""
-    from .plots import InlineFigure, STYLE, ground_acceleration, save_figure
-    from matplotlib import rc_context
-
-    free = np.flatnonzero(ds.block_free.values)
-    quake = ground_acceleration(ds)
-    with rc_context(STYLE):
-        fig = InlineFigure(figsize=(8, 6 if quake is None else 9.5))
-        axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
-        t = ds.time.values
-        for b in free:
-            axes[0].plot(t, np.degrees(ds.rocking_angle.values[:, b]), label=str(ds.block_name.values[b]))
-        axes[0].set_ylabel("rocking angle [deg]")
-        if len(free) <= 8:
-            axes[0].legend(loc="upper right", fontsize=8)
-        if ds.sizes.get("monitor", 0):
-            for j, name in enumerate(ds.monitor.values):
-                axes[1].plot(t, ds.monitor_displacement.values[:, j, 0] * 1e3, label=f"{name} (x)")
-            axes[1].set_ylabel("displacement [mm]")
-            axes[1].legend(loc="upper right", fontsize=8)
-        else:
-            for b in free:
-                axes[1].plot(t, ds.block_displacement.values[:, b, 0] * 1e3)
-            axes[1].set_ylabel("centroid displacement x [mm]")
-        if quake is not None:
-            from .spectra import plot_ground_motion_axes
-
-            plot_ground_motion_axes(tuple(axes[2:]), t, quake)
-        axes[-1].set_xlabel("time [s]")
-        fig.align_ylabels()
-        fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return save_figure(fig, path, dpi=120)
+    return draw_rocking(rocking_series(ds), path)
 
 
 def continue_command(args: argparse.Namespace, checkpoint: str | os.PathLike[str]) -> str:
@@ -325,20 +296,27 @@ def _run(args: argparse.Namespace) -> int:
     if every is not None and not save_ck:
         raise ValueError("--checkpoint-every needs checkpoints: drop --no-checkpoint ([output] checkpoint = false)")
     received: list[int] = []
-    with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
-        ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False, initial=initial,
-                      checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every, threads=args.threads)
-    wall = time.perf_counter() - t0
-    with hold_signals(received, "saving the results computed so far"):
-        written = [save(ds, out / "result.nc")]
-        if case.output["csv"]:
-            written.append(export_csv(ds, out / "histories.csv"))
-        if "contact_time" in ds.coords and case.output["contacts"] != "none":
-            written.append(write_contact_table(ds, out / "contacts", case.output["contacts"]))
-        if case.output["plot"] and not args.no_plot:
-            written.append(plot_rocking(ds, out / "rocking.png"))
-        if "checkpoint" in ds.attrs:
-            written.append(Path(ds.attrs["checkpoint"]))
+    plot = case.output["plot"] and not args.no_plot
+    # the plot is drawn by a second process, which imports Matplotlib while this one runs
+    with PlotProcess.take() if plot else contextlib.nullcontext() as plotter:
+        with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
+            ds = run_case(case, duration=args.duration, progress=None if not args.quiet else False, initial=initial,
+                          checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every,
+                          threads=args.threads)
+        wall = time.perf_counter() - t0
+        with hold_signals(received, "saving the results computed so far"):
+            series = rocking_series(ds) if plot else None
+            if plotter is not None:
+                plotter.submit(series, out / "rocking.png")
+            written = [save(ds, out / "result.nc")]
+            if case.output["csv"]:
+                written.append(export_csv(ds, out / "histories.csv"))
+            if "contact_time" in ds.coords and case.output["contacts"] != "none":
+                written.append(write_contact_table(ds, out / "contacts", case.output["contacts"]))
+            if plotter is not None:
+                written.append(plotter.draw(series, out / "rocking.png"))
+            if "checkpoint" in ds.attrs:
+                written.append(Path(ds.attrs["checkpoint"]))
     print(f"rockdem run: {case.name}")
     for line in summary_lines(ds):
         print("  " + line)

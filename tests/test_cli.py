@@ -412,3 +412,61 @@ def test_the_continue_command_of_an_interrupted_run_keeps_its_options(tmp_path):
     assert again.from_ == str(tmp_path / "out dir" / "checkpoint.npz") and again.settled is None
     for name in ("case", "duration", "out", "set", "stop", "quiet", "example", "threads", "no_plot"):
         assert getattr(again, name) == getattr(args, name), name
+
+
+def _plot_bytes_here(result_path, path):
+    from rockdem.rocking_plot import draw_rocking, rocking_series
+
+    return draw_rocking(rocking_series(load(result_path)), path).read_bytes()
+
+
+@pytest.mark.parametrize("loading", ["free-rocking", "earthquake"])
+def test_run_plot_is_drawn_by_a_second_process_as_here(tmp_path, capsys, monkeypatch, loading):
+    """`rockdem run` draws its plot in a second process (it imports Matplotlib while the run goes
+    on): the image is the one drawn in this process, byte for byte, for the two-panel plot and the
+    five-panel one of an earthquake run. Drawing here is forbidden, so the process drew it."""
+    import rockdem.rocking_plot
+
+    here = rockdem.rocking_plot.draw_rocking
+    monkeypatch.setattr(rockdem.rocking_plot, "draw_rocking", lambda *a: pytest.fail("drawn in this process"))
+    out = tmp_path / "o"
+    source = ["--example", "free-rocking"]
+    if loading == "earthquake":
+        source = [str(tmp_path / "quake.toml")]
+        (tmp_path / "quake.toml").write_text(
+            '[run]\nduration = 0.6\n[specimen]\ntype = "block"\nwidth = 0.3\nheight = 1.5\nyoungs_modulus = 1e9\n'
+            '[loading]\ntype = "earthquake"\nrecord = "elcentro-peknold"\nscale = 0.5\nmode = "inertial"\n')
+    assert main(["run", *source, "--out", str(out), "--duration", "0.6", "--quiet"]) == 0
+    monkeypatch.setattr(rockdem.rocking_plot, "draw_rocking", here)
+    assert ("ground_acceleration" in load(out / "result.nc")) == (loading == "earthquake")
+    assert (out / "rocking.png").read_bytes() == _plot_bytes_here(out / "result.nc", tmp_path / "here.png")
+
+
+@pytest.mark.parametrize("failure", ["no interpreter", "process fails"])
+def test_run_plot_is_drawn_here_where_the_plot_process_fails(tmp_path, capsys, monkeypatch, failure):
+    """Where the plotting process cannot start or exits with an error, the run draws the plot itself
+    (the same image) and says nothing of it."""
+    import rockdem.rocking_plot
+
+    if failure == "no interpreter":
+        monkeypatch.setattr(sys, "executable", str(tmp_path / "no-python"))
+    else:
+        monkeypatch.setattr(rockdem.rocking_plot, "_SERVE_CODE", "import sys; sys.stdin.read(1); sys.exit(3)  # {root}")
+    out = tmp_path / "o"
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.3", "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+    assert (out / "rocking.png").read_bytes() == _plot_bytes_here(out / "result.nc", tmp_path / "here.png")
+
+
+def test_a_plot_process_given_nothing_to_draw_ends_at_once():
+    """A run that ends before its plot (an error) ends its plotting process: killed, not left to
+    finish importing Matplotlib, and reaped (no process left behind)."""
+    import time
+
+    from rockdem.rocking_plot import PlotProcess
+
+    t0 = time.perf_counter()
+    with PlotProcess() as plotter:
+        proc = plotter._process
+    assert proc is not None and proc.returncode is not None and proc.returncode != 0
+    assert time.perf_counter() - t0 < 0.3  # Matplotlib's import alone takes longer
