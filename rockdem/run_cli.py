@@ -297,6 +297,8 @@ def _run(args: argparse.Namespace) -> int:
         raise ValueError("--checkpoint-every needs checkpoints: drop --no-checkpoint ([output] checkpoint = false)")
     received: list[int] = []
     plot = case.output["plot"] and not args.no_plot
+    if not plot:
+        PlotProcess.discard_early()  # started by the command line before the case said no plot
     # the plot is drawn by a second process, which imports Matplotlib while this one runs
     with PlotProcess.take() if plot else contextlib.nullcontext() as plotter:
         with stop_on_signals(received):  # SIGTERM and SIGHUP stop the run as Ctrl-C does
