@@ -461,12 +461,11 @@ def test_run_plot_is_drawn_here_where_the_plot_process_fails(tmp_path, capsys, m
 def test_a_plot_process_given_nothing_to_draw_ends_at_once():
     """A run that ends before its plot (an error) ends its plotting process: killed, not left to
     finish importing Matplotlib, and reaped (no process left behind)."""
-    import time
+    import signal
 
     from rockdem.rocking_plot import PlotProcess
 
-    t0 = time.perf_counter()
     with PlotProcess() as plotter:
         proc = plotter._process
-    assert proc is not None and proc.returncode is not None and proc.returncode != 0
-    assert time.perf_counter() - t0 < 0.3  # Matplotlib's import alone takes longer
+    assert proc is not None and proc.returncode is not None  # reaped
+    assert proc.returncode == (-signal.SIGKILL if hasattr(signal, "SIGKILL") else 1)  # killed, not finished
