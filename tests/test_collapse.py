@@ -432,3 +432,47 @@ def test_a_face_landing_across_its_partners_edge_gets_an_impact_window(foundatio
     assert np.abs(rel).max() <= 0.002
     mech = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
     assert (mech - mech[0]).max() <= 1e-3 * float(np.max(np.abs(ds.energy_balance_error.values) / np.maximum(np.abs(rel), 1e-300)))
+
+
+def test_a_face_contact_handed_to_an_edge_pair_gives_its_energy_at_the_present_pose():
+    """When a loaded face contact becomes an edge-edge contact, the edge spring starts with the
+    energy the face springs hold *now* (detect._pair_face_energy): each kn A (u - set)^2 / 2 with u
+    its overlap at the present pose, here checked against the points' heights over the partner's
+    plane computed from the blocks' poses (a block rocking on its toe, then moved as a step would
+    move it). Their energy at their last law pass is a step old: the cube sliding off the wall top
+    onto its edge (edge_on_wall) handed over 38.7 J where its springs held 36.8 J, and the balance
+    rose by 1.35 J in one step."""
+    from rockdem.kernels.detect import _pair_face_energy, update_rotations
+    from rockdem.kernels.rotation import quat_integrate
+    from rockdem.simulation import prepare_start, run_model
+
+    model = rocking_block(0.3, 1.2, points=(3, 2), tilt=0.6)
+    start = prepare_start(model)
+    run_model(model, 0.25, progress=False, start=start)  # rocking on its toe, the toe's springs loaded
+    m, s, sc = model.arrays, start.state, start.scratch
+    blk = model.block_id("block")
+    kn = float(m.mat_kn[m.block_group[0], m.block_group[blk]])
+    loaded = [(p, k) for p in range(m.point_block.shape[0]) for k in range(s.slot_partner.shape[1])
+              if s.slot_partner[p, k] >= 0 and s.slot_normal_force[p, k] > 0.0 and s.slot_area[p, k] > 0.0]
+    assert len(loaded) >= 2
+    last_step = sum(float(s.slot_normal_force[p, k]) ** 2 / (2.0 * kn * s.slot_area[p, k]) for p, k in loaded)
+    # The pose a step of 20 times the run's moves it to (its velocity over 20 dt).
+    h = 20.0 * float(s.dt[0])
+    s.position[blk] += h * s.velocity[blk]
+    quat_integrate(s.quaternion[blk], s.omega[blk], h)
+    update_rotations(m, s, sc)
+
+    def world(b, x):
+        return sc.rotation[b] @ x + s.position[b]
+
+    expected = 0.0
+    for p, k in loaded:
+        f, ft = int(m.point_face[p]), int(s.slot_face[p, k])
+        o, t = int(m.face_block[f]), int(m.face_block[ft])
+        x = world(o, m.face_origin[f] + m.point_node[p, 0] * m.face_u[f] + m.point_node[p, 1] * m.face_w[f])
+        n = sc.rotation[t] @ m.face_normal[ft]
+        u = -float(n @ (x - world(t, m.face_origin[ft]))) - float(s.slot_set[p, k])
+        expected += 0.5 * kn * float(s.slot_area[p, k]) * max(u, 0.0) ** 2
+    assert abs(expected - last_step) > 0.02 * last_step  # the pose moved the springs' energy
+    assert _pair_face_energy(m, s, sc, 0, blk) == pytest.approx(expected, rel=1e-9)
+    assert all(s.slot_normal_force[p, k] == 0.0 for p, k in loaded)  # taken from the face springs

@@ -28,7 +28,7 @@ from numba import njit
 
 from .blend import face_clearance, tracks_target
 from .contact import spring_energy
-from .faces import cover, face_map
+from .faces import anchored_overlap, cover, face_map
 from .layout import (
     E_BOND,
     E_FRICTION,
@@ -390,10 +390,16 @@ def _prev_edge_energy_now(m: ModelArrays, s: State, sc: Scratch, k: int, kn: flo
 
 
 @njit(cache=True, _nrt=False)
-def _pair_face_energy(m: ModelArrays, s: State, a: int, b: int) -> float:
-    """Elastic energy [J] of the compressed normal springs of the face sub-contacts between blocks
-    a and b, which is taken from them (their normal force is zeroed, so releasing them books only
-    their shear springs). Cost: the two blocks' points."""
+def _pair_face_energy(m: ModelArrays, s: State, sc: Scratch, a: int, b: int) -> float:
+    """Elastic energy [J] that the compressed normal springs of the face sub-contacts between
+    blocks a and b would hold at the present pose (rotations current), which is taken from them
+    (their normal force is zeroed, so releasing them books only their shear springs): each spring
+    kn A (u - set)^2 / 2 with its last area A, u its overlap now as its law measures it
+    (:func:`rockdem.kernels.faces.anchored_overlap` with its last cover weight, anchor and deepest
+    vertex; the point's own overlap without cover weight). Its energy at its last law pass is a
+    step old: a cube sliding off a wall top onto its edge, its face springs unloading, handed its
+    edge spring their last step's 38.7 J where they held 36.8 J, and the balance rose by 1.35 J
+    (0.19 % of the scale) in that step (edge_on_wall, 2026-11-29). Cost: the two blocks' points."""
     e = 0.0
     for side in range(2):
         blk, oth = (a, b) if side == 0 else (b, a)
@@ -401,9 +407,17 @@ def _pair_face_energy(m: ModelArrays, s: State, a: int, b: int) -> float:
         for f in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
             for p in range(m.face_point_start[f], m.face_point_start[f + 1]):
                 for k in range(SLOTS):
-                    fn = s.slot_normal_force[p, k]
-                    if s.slot_partner[p, k] == oth and fn > 0.0 and s.slot_area[p, k] > 0.0:
-                        e += spring_energy(fn, m.mat_kn[gb, go] * s.slot_area[p, k])
+                    if s.slot_partner[p, k] == oth and s.slot_normal_force[p, k] > 0.0 and s.slot_area[p, k] > 0.0:
+                        fm = face_map(m, s, sc, f, s.slot_face[p, k])
+                        w = s.slot_cover[p, k]
+                        if w > 0.0:
+                            un = anchored_overlap(fm, s.slot_anchor[p, k, 0], s.slot_anchor[p, k, 1], s.slot_deepest[p, k, 0],
+                                                  s.slot_deepest[p, k, 1], w, m.touch_tol)
+                        else:
+                            un = -(fm.h0 + fm.hu * m.point_node[p, 0] + fm.hw * m.point_node[p, 1])
+                        un -= s.slot_set[p, k]
+                        if un > 0.0:
+                            e += 0.5 * m.mat_kn[gb, go] * s.slot_area[p, k] * un * un
                         s.slot_normal_force[p, k] = 0.0
     return e
 
@@ -433,7 +447,7 @@ def hand_over_edge(m: ModelArrays, s: State, sc: Scratch, i: int, k: int) -> Non
             budget = _prev_edge_energy_now(m, s, sc, k, m.mat_kn[ga, gb])
             sc.prev_pair_normal_force[k] = 0.0  # handed over, not released
         else:
-            budget = _pair_face_energy(m, s, a, b)
+            budget = _pair_face_energy(m, s, sc, a, b)
     un = edge_contact(m, s, sc, i)[0]
     held = 0.5 * kna * un * un if un > 0.0 else 0.0
     if held <= budget:
