@@ -176,7 +176,11 @@ class PlotProcess:
             assert proc.stdout is not None
             reply = proc.stdout.read()
             if proc.wait() == 0 and reply:
-                for message, module, name in pickle.loads(reply):  # the category if loaded here, else UserWarning
+                try:
+                    caught = pickle.loads(reply)
+                except Exception:  # something else wrote on its stdout (a sitecustomize): the plot is saved
+                    caught = []
+                for message, module, name in caught:  # the category if loaded here, else UserWarning
                     category = getattr(sys.modules.get(module), name, UserWarning)
                     warnings.warn(message, category if isinstance(category, type) and issubclass(category, Warning)
                                   else UserWarning, stacklevel=2)
