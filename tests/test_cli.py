@@ -469,3 +469,20 @@ def test_a_plot_process_given_nothing_to_draw_ends_at_once():
         proc = plotter._process
     assert proc is not None and proc.returncode is not None  # reaped
     assert proc.returncode == (-signal.SIGKILL if hasattr(signal, "SIGKILL") else 1)  # killed, not finished
+
+
+def test_the_plot_process_passes_its_warnings_on(tmp_path, monkeypatch):
+    """A warning raised while the second process draws (here Matplotlib's, for a legend whose only
+    label starts with an underscore) is raised again in the run's process, with its category."""
+    import rockdem.rocking_plot
+    from rockdem.rocking_plot import PlotProcess, RockingSeries
+
+    monkeypatch.setattr(rockdem.rocking_plot, "draw_rocking", lambda *a: pytest.fail("drawn in this process"))
+    t = np.linspace(0.0, 1.0, 50)
+    series = RockingSeries(time=t, blocks=("_hidden",), angle=np.sin(t)[:, None], displacement=np.cos(t)[:, None],
+                           monitors=(), quake=None)
+    with PlotProcess() as plotter:
+        plotter.submit(series, tmp_path / "p.png")
+        with pytest.warns(UserWarning, match="No artists with labels found to put in legend"):
+            assert plotter.draw(series, tmp_path / "p.png") == tmp_path / "p.png"
+    assert (tmp_path / "p.png").stat().st_size > 1000
