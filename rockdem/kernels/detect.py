@@ -408,14 +408,10 @@ def _pair_face_energy(m: ModelArrays, s: State, sc: Scratch, a: int, b: int) -> 
             for p in range(m.face_point_start[f], m.face_point_start[f + 1]):
                 for k in range(SLOTS):
                     if s.slot_partner[p, k] == oth and s.slot_normal_force[p, k] > 0.0 and s.slot_area[p, k] > 0.0:
-                        fm = face_map(m, s, sc, f, s.slot_face[p, k])
-                        w = s.slot_cover[p, k]
-                        if w > 0.0:
-                            un = anchored_overlap(fm, s.slot_anchor[p, k, 0], s.slot_anchor[p, k, 1], s.slot_deepest[p, k, 0],
-                                                  s.slot_deepest[p, k, 1], w, m.touch_tol)
-                        else:
-                            un = -(fm.h0 + fm.hu * m.point_node[p, 0] + fm.hw * m.point_node[p, 1])
-                        un -= s.slot_set[p, k]
+                        un = anchored_overlap(
+                            face_map(m, s, sc, f, s.slot_face[p, k]), m.point_node[p, 0], m.point_node[p, 1],
+                            s.slot_anchor[p, k, 0], s.slot_anchor[p, k, 1], s.slot_deepest[p, k, 0], s.slot_deepest[p, k, 1],
+                            s.slot_cover[p, k], m.touch_tol) - s.slot_set[p, k]
                         if un > 0.0:
                             e += 0.5 * m.mat_kn[gb, go] * s.slot_area[p, k] * un * un
                         s.slot_normal_force[p, k] = 0.0

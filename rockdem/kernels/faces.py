@@ -256,11 +256,16 @@ def _cell_to_target(cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.nda
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def anchored_overlap(fm: FaceMap, au: float, aw: float, eu: float, ew: float, cover_w: float, touch_tol: float) -> float:
-    """Overlap u_q + w phi(g) [m] of a partly covered cell at the pose of ``fm``, measured as
-    :func:`partly_covered` measures it, with its anchor q = (au, aw), deepest covered vertex
-    d = (eu, ew) (owner face coordinates [m]) and cover weight w kept: with those of the last step,
-    how deep the cell would be now had its cover not moved."""
+def anchored_overlap(
+    fm: FaceMap, nu: float, nw: float, au: float, aw: float, eu: float, ew: float, cover_w: float, touch_tol: float,
+) -> float:
+    """Overlap [m] of point (nu, nw)'s cell at the pose of ``fm``, measured as :func:`partly_covered`
+    measures it, with its cover weight w, anchor q = (au, aw) and deepest covered vertex d = (eu, ew)
+    (owner face coordinates [m]) kept: u_q + w phi(g), or the point's own overlap where w is 0
+    (q and d are then not read). With those of the last step: how deep the cell would be now had
+    its cover not moved."""
+    if cover_w == 0.0:
+        return -(fm.h0 + fm.hu * nu + fm.hw * nw)
     uq = -(fm.h0 + fm.hu * au + fm.hw * aw)
     g = -(fm.hu * (eu - au) + fm.hw * (ew - aw))
     if g <= 0.0:

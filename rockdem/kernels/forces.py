@@ -735,13 +735,10 @@ def _law_range(
             un_cover = un
             deepened = 0.0
             if prev_area > 0.0:
-                u_node = -(fm.h0 + fm.hu * m.point_node[p, 0] + fm.hw * m.point_node[p, 1])
-                w_old = s.slot_cover[p, j]
-                u_old = u_node if w_old == 0.0 else anchored_overlap(
-                    fm, s.slot_anchor[p, j, 0], s.slot_anchor[p, j, 1], s.slot_deepest[p, j, 0], s.slot_deepest[p, j, 1],
-                    w_old, m.touch_tol)
-                u_now = u_node if cover_w == 0.0 else anchored_overlap(fm, au, aw, eu, ew, cover_w, m.touch_tol)
-                deepened = u_now - u_old
+                nu, nw = m.point_node[p, 0], m.point_node[p, 1]
+                deepened = anchored_overlap(fm, nu, nw, au, aw, eu, ew, cover_w, m.touch_tol) - anchored_overlap(
+                    fm, nu, nw, s.slot_anchor[p, j, 0], s.slot_anchor[p, j, 1], s.slot_deepest[p, j, 0],
+                    s.slot_deepest[p, j, 1], s.slot_cover[p, j], m.touch_tol)
             un, e_set = cover_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn, deepened, cut and not blending)
             shift += un - un_cover
             e_fric += e_set
