@@ -153,6 +153,16 @@ def prepare_record(
     return gm.with_tail(max(tail, gm.dt))
 
 
+MAX_SUBSTEPS = 1024
+"""Most velocity samples per record interval :func:`apply_earthquake` takes."""
+TABLE_ROW_BYTES = 96
+"""Memory [bytes] that one row of the foundation's velocity table takes at its peak
+(:func:`_velocity_table`'s temporaries and the model's copy; measured 1.1 GB of peak resident
+memory for a run whose table had 13.6 million rows)."""
+MAX_TABLE_BYTES = 2e9
+"""Largest input table :func:`apply_earthquake` builds [bytes]."""
+
+
 def apply_earthquake(
     builder: ModelBuilder,
     motion: GroundMotion,
@@ -196,8 +206,20 @@ def apply_earthquake(
         raise ValueError(f"earthquake mode must be one of {list(EARTHQUAKE_MODES)}, got {mode!r}")
     if not (math.isfinite(delay) and delay >= 0.0):
         raise ValueError(f"earthquake delay must be >= 0 s, got {delay!r}")
+    if not (math.isfinite(tail) and tail >= 0.0):
+        raise ValueError(f"earthquake tail must be >= 0 s, got {tail!r}")
+    if not (math.isfinite(substeps) and float(substeps).is_integer() and 1 <= substeps <= MAX_SUBSTEPS):
+        raise ValueError(f"substeps must be an integer from 1 to {MAX_SUBSTEPS}, got {substeps!r} (the foundation's "
+                         "velocity differs from the exact integral by O(1/substeps^2): the default 16 suffices)")
     gm = prepare_record(motion, scale=scale, pga=pga, direction=direction, vertical=vertical,
                         baseline=baseline, tail=tail, window=window)
+    per = int(substeps) if mode == "foundation" else 1
+    if gm.npts * per * TABLE_ROW_BYTES > MAX_TABLE_BYTES:
+        raise ValueError(
+            f"{gm.name}: the input table would have {gm.npts * per:.3g} rows ({gm.npts} samples of {gm.dt:g} s, the tail "
+            f"of {tail:g} s included" + (f", {per} substeps each" if per > 1 else "") + f"), about "
+            f"{gm.npts * per * TABLE_ROW_BYTES / 1e9:.1f} GB to build (at most {MAX_TABLE_BYTES / 1e9:g} GB); shorten "
+            "the tail (the input's end value is held after it: no tail beyond the run's end is needed) or the window")
     acc = gm.vector_acceleration()
     vel = gm.vector_velocity()  # from rest: v(t_0) = 0
     t = delay + gm.dt * np.arange(gm.npts)
@@ -710,7 +732,8 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
     scale = t.number("scale", 1.0, min_=0.0)
     pga_g = t.optional_number("pga_g", positive=True)
     if pga_g is not None and "scale" in t.data:
-        raise ValueError(f"[{t.where}] give scale or pga_g, not both")
+        raise ValueError(f"[{t.where}] give scale or pga_g, not both (on the command line --set {t.where}.scale= "
+                         "removes the case's scale)")
     window = t.raw("window")
     if window is not None:
         window = tuple(t.vector("window", size=2))

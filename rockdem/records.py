@@ -60,6 +60,9 @@ STANDARD_GRAVITY = 9.80665
 DT_RTOL = 1e-6
 """Relative tolerance on the spacing of a time column, as a fraction of dt."""
 
+MAX_TAIL_SAMPLES = 10_000_000
+"""Most zero samples :meth:`GroundMotion.with_tail` appends (80 MB per component)."""
+
 _HEADER_SCAN_LINES = 12  # an AT2 header (NPTS/DT line included) must lie within the first lines
 
 
@@ -278,7 +281,13 @@ class GroundMotion:
         """
         if not np.isfinite(seconds) or seconds < 0.0:
             raise ValueError(f"{self.name}: tail length must be >= 0 seconds, got {seconds!r}")
-        zeros = np.zeros(int(round(seconds / self.dt)))
+        n = round(seconds / self.dt)
+        if n > MAX_TAIL_SAMPLES:
+            raise ValueError(
+                f"{self.name}: a tail of {seconds:g} s at dt = {self.dt:g} s is {n:.3g} samples of zeros "
+                f"(at most {MAX_TAIL_SAMPLES:.0e}); shorten the tail (a simulation holds the record's end "
+                "value after it: no tail beyond the run's end is needed)")
+        zeros = np.zeros(int(n))
         vertical = None if self.vertical is None else np.concatenate([self.vertical, zeros])
         return replace(self, acceleration=np.concatenate([self.acceleration, zeros]), vertical=vertical)
 
@@ -918,7 +927,12 @@ def _records_cli(args: argparse.Namespace) -> int:
         from .cli import output_file
         from .spectra import save_record_plot
 
-        gm = read_record(args.name)
+        try:
+            gm = read_record(args.name, units=args.units, dt=args.dt, time_column=args.time_column,
+                             acc_column=args.acc_column)
+        except ValueError as exc:  # the reader's advice names its keyword arguments: name the options too
+            raise ValueError(f"{exc} (options of rockdem records --plot: --units, --dt, --time-column, "
+                             "--acc-column)") from None
         shipped = shipped_record(args.name)
         label = f"{shipped.name} ({shipped.event} {shipped.date[:4]}, {shipped.station})" if shipped else gm.name
         out = Path(args.output) if args.output else Path(f"{shipped.name if shipped else Path(args.name).stem}_record.png")
@@ -968,4 +982,9 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
                    help="plot NAME (a shipped record, a file in $ROCKDEM_DATA or a path): acceleration, velocity, "
                         "displacement and its 5 %% damped response spectrum")
     p.add_argument("-o", "--output", help="file for --plot (.png or .pdf; default NAME_record.png)")
+    p.add_argument("--units", choices=("g", "m/s2", "cm/s2"),
+                   help="--plot: acceleration units of a file that does not say them (columns or single-column files)")
+    p.add_argument("--dt", type=float, help="--plot: time step [s] of a single-column file")
+    p.add_argument("--time-column", type=int, help="--plot: zero-based time column of a columns file (default 0)")
+    p.add_argument("--acc-column", type=int, help="--plot: zero-based acceleration column of a columns file (default 1)")
     p.set_defaults(func=_records_cli)

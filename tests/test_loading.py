@@ -45,6 +45,23 @@ def test_velocity_table_is_exact_for_piecewise_linear_acceleration():
     assert vv[0, 0] == 0.0  # starts from rest
 
 
+def test_earthquake_tables_are_bounded_before_they_are_built():
+    """A tail or substep count whose input table would take gigabytes is refused, naming the field,
+    before any memory is taken (a 2000 s tail on a 0.0024 s record built a 13.6 million row table,
+    1.1 GB; 1e5 s exhausted the machine's memory)."""
+    gm = read_record(resolve_record("RSN6_IMPVALL.I_I-ELC180.AT2"))  # dt 0.01 s
+    bld = _block_builder(0.2, 1.0, 0.5, points=2, kn=1e9, ground="ground")
+    with pytest.raises(ValueError, match="input table would have .* the tail of 20000 s included, 16 substeps each.*shorten the tail"):
+        apply_earthquake(bld, gm, tail=2e4)
+    for substeps in (0, 2000, 2.5, math.nan):
+        with pytest.raises(ValueError, match="substeps must be an integer from 1 to 1024"):
+            apply_earthquake(bld, gm, substeps=substeps)
+    with pytest.raises(ValueError, match="earthquake tail must be >= 0 s"):
+        apply_earthquake(bld, gm, tail=math.inf)
+    info = apply_earthquake(bld, gm, tail=5.0)  # an ordinary tail: zeros at the record's dt
+    assert info.time[-1] == pytest.approx(gm.duration + 5.0) and np.all(info.acceleration[-500:] == 0.0)
+
+
 def test_foundation_and_inertial_modes_give_the_same_rocking():
     # Frame invariance: contact forces and SP dashpots see only relative motion, so a block on a
     # rigid foundation moved by v_g(t) rocks like a block on a fixed one under -m a_g(t).

@@ -379,6 +379,8 @@ def test_scaling_and_tail() -> None:
     assert target.vertical is not None and target.vertical[1] == pytest.approx(1.5)  # V/H ratio kept
     tail = gm.with_tail(0.05)
     assert tail.npts == 9 and tail.dt == gm.dt and np.all(tail.acceleration[4:] == 0.0)
+    with pytest.raises(ValueError, match="a tail of 1e\\+06 s at dt = 0.01 s is 1e\\+08 samples .* shorten the tail"):
+        gm.with_tail(1e6)  # 0.8 GB of zeros, refused before any is allocated
 
 
 def test_constant_acceleration_integrates_exactly() -> None:
