@@ -125,6 +125,11 @@ class Table:
         :data:`~rockdem.geometry.MAX_FACE_POINTS` per face)."""
         a = self.integer("points_across", across, min_=1, max_=MAX_FACE_POINTS)
         b = self.integer("points_along", along, min_=1, max_=MAX_FACE_POINTS)
+        for key, n in (("points_across", a), ("points_along", b)):
+            if n < 2:
+                raise ValueError(
+                    f"[{self.where}] {key} = 1 puts a face's only point at its middle: a block on it balances on a "
+                    "knife edge and cannot rock about its edges; give 2 or more (the paper uses 2 to 15)")
         if a * b > MAX_FACE_POINTS:
             raise ValueError(
                 f"[{self.where}] points_across x points_along = {a} x {b} exceeds the limit of {MAX_FACE_POINTS} "
@@ -382,6 +387,9 @@ def _free_rocking(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: 
         raise ValueError(f"[{t.where}] the specimen has no free block to tilt")
     frac = t.number("tilt_fraction", 0.9, min_=0.0)
     d = t.vector("tilt_direction", (1.0, 0.0, 0.0))
+    if not np.any(b.gravity):
+        warn_user(f"[{t.where}] free rocking with [specimen] gravity = 0: nothing brings the tilted blocks back, "
+                  "they stay where they are released")
     try:
         angle = b.tilt(names, frac, direction=d)
     except ValueError as exc:
@@ -483,7 +491,8 @@ def parse_assignment(item: str) -> tuple[str, Any]:
 
 
 def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, Any]:
-    """Apply ``table.key=value`` overrides (value parsed as TOML, else kept as a string)."""
+    """Apply ``table.key=value`` overrides (value parsed as TOML, else kept as a string); an empty
+    value (``table.key=``) removes the key, e.g. a record's ``scale`` to give ``pga_g`` instead."""
     if not isinstance(data, Mapping):
         raise ValueError(f"overrides apply to a case (a dict), got {_short(data)}")
     if isinstance(overrides, (str, bytes)) or not all(isinstance(o, str) for o in overrides):
@@ -492,6 +501,14 @@ def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, 
     for item in overrides:
         path, parsed = parse_assignment(item)
         keys = path.split(".")
+        if item.split("=", 1)[1].strip() == "":
+            parent = out
+            for k in keys[:-1]:
+                parent = parent.get(k) if isinstance(parent, dict) else None
+            if not isinstance(parent, dict) or keys[-1] not in parent:
+                raise ValueError(f"--set {item!r}: an empty value removes a key, and the case has no {path}")
+            del parent[keys[-1]]
+            continue
         node = out
         for k in keys[:-1]:
             node = node.setdefault(k, {})

@@ -7,6 +7,8 @@ import numbers
 from dataclasses import dataclass, fields
 from typing import Any, Mapping
 
+from ._warn import warn_user
+
 #: Outside these, a value is almost surely in the wrong unit (masonry: 1500-2500 kg/m^3, E 1-20 GPa).
 PLAUSIBLE_DENSITY = 100.0  # [kg/m^3]
 HEAVIEST_DENSITY = 12_000.0  # [kg/m^3] heavier than lead
@@ -103,6 +105,10 @@ class JointMaterial:
         # NaN or a zero stiffness would otherwise stall the run at t = 0
         for name, value in check_material({f.name: getattr(self, f.name) for f in fields(self)}, "JointMaterial:").items():
             object.__setattr__(self, name, value)
+        if self.residual_friction_angle is not None and self.residual_friction_angle > self.friction_angle:
+            warn_user(f"JointMaterial: residual_friction_angle = {self.residual_friction_angle:g} deg exceeds "
+                      f"friction_angle = {self.friction_angle:g} deg: a joint would hold more in friction after its "
+                      "bond fails than before (a residual angle is normally at most the peak one)")
 
     @classmethod
     def from_modulus(

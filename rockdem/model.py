@@ -441,6 +441,10 @@ class ModelBuilder:
         if not (driven is False or driven is True or isinstance(driven, Motion) or (isinstance(driven, str) and driven == GROUND)):
             raise ValueError(f"block {name!r}: driven must be False, True, 'ground' or a Motion, got {driven!r}")
         pts = self.points if points is None else _check_points(points, f"block {name!r} points")
+        if driven is False and min(pts) < 2:
+            warn_user(f"block {name!r}: {pts[0]} x {pts[1]} interface points per face: a face's only point across "
+                      "(or along) it sits at its middle, so the block balances on it instead of rocking about its "
+                      "edges; give 2 or more (points=(across, along))")
         self._blocks.append(
             _Block(
                 name,
@@ -483,10 +487,14 @@ class ModelBuilder:
     ) -> None:
         """Move block ``i`` rigidly: rotate by matrix ``rotation`` about point ``about``, then
         translate by ``translation`` [m]."""
-        r = np.asarray(rotation, dtype=float)
-        a = np.asarray(about, dtype=float)
         blk = self._blocks[self._index(i)]
-        blk.poly = blk.poly.transformed(r, a - r @ a + np.asarray(translation, dtype=float))
+        r = _float_array(rotation, f"block {blk.name!r}: rotation")
+        if r.shape != (3, 3) or not np.all(np.isfinite(r)) or not np.allclose(r @ r.T, np.eye(3), atol=1e-9) \
+                or np.linalg.det(r) < 0.0:
+            raise ValueError(f"block {blk.name!r}: rotation must be a 3 x 3 rotation matrix (orthonormal, determinant +1: "
+                             f"a rigid move, no scaling, shear or mirror), got {np.array2string(r, precision=4)}")
+        a = _vector3(about, f"block {blk.name!r}: about [m]")
+        blk.poly = blk.poly.transformed(r, a - r @ a + _vector3(translation, f"block {blk.name!r}: translation [m]"))
 
     def group(self, i: int | str) -> str:
         """Joint-material group of block ``i`` (id or name)."""
@@ -799,6 +807,10 @@ class ModelBuilder:
             contact_tolerance = max(0.01 * min_dim, 1.5 * opening)
         if not (math.isfinite(contact_tolerance) and contact_tolerance > 0):
             raise ValueError(f"contact_tolerance must be a positive length [m], got {contact_tolerance!r}")
+        if contact_tolerance > 0.5 * min_dim:
+            warn_user(f"contact_tolerance = {contact_tolerance:g} m exceeds half the smallest block dimension "
+                      f"({min_dim:g} m): faces that are far apart are tracked as near contact (slow, and the "
+                      "contact figures lose their meaning); the default is 1 % of that dimension")
         if rocking_axis is None:
             rocking_axis = self.default_rocking_axis()
         axis = np.asarray(rocking_axis, dtype=float).reshape(3) + 0.0  # + 0.0: no -0.0

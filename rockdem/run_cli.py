@@ -227,6 +227,11 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
         return [_row("rocking analysis", "skipped", "", str(exc))]
     out = []
     diverged = bool(ds.attrs.get("diverged"))
+    stop = ds.attrs.get("stop_reason")
+    # A run stopped at collapse whose analysed block did not overturn about its own base (a column
+    # toppling as one, its top block falling first): the row must not read as "no collapse".
+    collapse = (f"this block about its own base; the run stopped at collapse (block {ds.attrs.get('stop_block')!r} "
+                f"{'fell' if stop == 'fell' else 'overturned'})") if stop in ("fell", "overturned") else ""
     for key, value in summary.items():
         label, unit, fmt = _ANALYSIS_ROWS.get(key, (key.replace("_", " "), "", ""))
         if key in skip:
@@ -234,6 +239,8 @@ def _analysis_lines(ds: xr.Dataset, block: int, skip: tuple[str, ...] = ()) -> l
         if isinstance(value, bool):
             # a run cut as diverged (sunk, lost, energy created) has no outcome: its last frames are unsound
             note = "the run diverged: not an outcome" if diverged and key in ("exceeded_eta", "overturned") else ""
+            if collapse and not value and key in ("exceeded_eta", "overturned"):
+                note = collapse
             out.append(_row(label, "yes" if value else "no", unit, note))
         elif isinstance(value, (int, float, np.number)):
             out.append(_row(label, format(value, fmt or ".4g") if fmt != "d" else f"{int(value)}", unit))
@@ -352,7 +359,8 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--example", help=f"built-in example ({', '.join(example_names())})")
     p.add_argument("--list-examples", action="store_true", help="list the built-in examples")
     p.add_argument("--out", "-o", help="output directory (default results/<case name>)")
-    p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE", help="override a case value")
+    p.add_argument("--set", action="append", metavar="TABLE.KEY=VALUE",
+                   help="override a case value (repeatable); TABLE.KEY= with no value removes the key")
     p.add_argument("--duration", type=positive_float, help="simulated time [s], overrides [run] duration")
     p.add_argument("--stop", choices=STOP_MODES, default=None,
                    help="end the run once its outcome is decided: collapsed, or at rest after the input "

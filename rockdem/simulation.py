@@ -782,6 +782,8 @@ def _check_monitors(model: Model, monitors: Mapping[str, Monitor]) -> dict[str, 
             raise ValueError(
                 f"monitor {name!r}: give (block, (x, y, z)) with the world position at t = 0 [m], got {spec!r}"
             ) from None
+        if not np.all(np.isfinite(p)):
+            raise ValueError(f"monitor {name!r}: the point (x, y, z) must be finite [m], got {tuple(p.tolist())}")
         b = model.block_id(blk) if isinstance(blk, str) else int(blk)
         if not 0 <= b < model.block_count:
             raise ValueError(f"monitor {name!r}: block id {b} out of range")

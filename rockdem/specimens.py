@@ -541,7 +541,7 @@ def facade(
     # inner top edge after the lean (rotation about y by -phi moves the top towards -x)
     rot = axis_angle_matrix(np.array([0.0, 1.0, 0.0]), -phi)
     inner_top = rot @ np.array([0.5 * b, 0.0, min(h, hr)])
-    if inner_top[0] >= 0.5 * b + g:
+    if inner_top[0] - (0.5 * b + g) > 1e-9 * b:  # touching (gap 0, no slope) is allowed
         raise ValueError(
             f"slope_deg = {slope_deg} leans the façade into the return walls (top moves "
             f"{inner_top[0] - 0.5 * b:.4g} m inward, gap {g} m); use a smaller inward slope or a larger gap"

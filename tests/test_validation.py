@@ -142,6 +142,8 @@ def test_missing_material_and_no_free_block():
         (("specimen", "type", "pyramid"), r"\[specimen\] type must be one of"),
         (("damping", "beta", "big"), r"\[damping\] beta must be a finite number"),
         (("specimen", "points_across", 0), r"\[specimen\] points_across must be >= 1"),
+        (("specimen", "points_across", 1), r"\[specimen\] points_across = 1 .* knife edge"),
+        (("specimen", "points_along", 1), r"\[specimen\] points_along = 1 .* give 2 or more"),
         (("specimen", "kn", 1e9), r"give exactly one of kn"),
     ],
 )
@@ -230,6 +232,11 @@ def test_damping_is_checked_on_construction(kwargs, field):
         (lambda b: b.set_material("a", "b", None), "material must be a JointMaterial"),
         (lambda b: b.set_ground_motion("quake"), "give a Motion"),
         (lambda b: b.set_body_acceleration([0, 1], [[1, 0]]), r"acceleration \(n, 3\) must match"),
+        (lambda b: b.transform_block("block", 2.0 * np.eye(3)), "rotation must be a 3 x 3 rotation matrix"),
+        (lambda b: b.transform_block("block", [[1, 0.3, 0], [0, 1, 0], [0, 0, 1]]), "orthonormal"),
+        (lambda b: b.transform_block("block", np.diag([1.0, 1.0, -1.0])), "mirror"),
+        (lambda b: b.transform_block("block", np.eye(2)), "3 x 3"),
+        (lambda b: b.transform_block("block", np.eye(3), translation=(0, 0, math.nan)), "translation"),
     ],
 )
 def test_builder_arguments_are_checked(call, message):
@@ -469,3 +476,50 @@ def test_a_block_beside_a_foundation_that_moves_back_under_it_has_fallen_off_not
     x, z = ds.block_position.sel(block="cube").values[-1, [0, 2]]
     edge = float(ds.block_position.sel(block="ground").values[-1, 0]) + 2.0
     assert x < edge and z < m.arrays.extent_low[2]  # under the foundation's plan now, below the extent
+
+
+def test_a_free_block_with_one_point_across_its_faces_is_warned_about():
+    """One point across a face sits at its middle: the block cannot rock about its edges. A driven
+    rod (one point across its thin face) is left alone."""
+    b = _builder()
+    with pytest.warns(UserWarning, match="balances on it"):
+        b.add_box(0.2, 1, 1, name="block", points=(1, 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        b.add_box(0.02, 0.5, 0.02, base_center=(1, 0, 1), driven=True, name="rod", points=(1, 2))
+
+
+@pytest.mark.parametrize("point", [(0.0, 0.0, math.nan), (0.0, math.inf, 0.5)])
+def test_a_monitor_point_must_be_finite(point):
+    b = _builder()
+    b.add_box(0.2, 0.5, 1.0, density=2000, name="block")
+    with pytest.raises(ValueError, match="monitor 'top': the point .* must be finite"):
+        simulate(b.finalize(), 0.01, monitors={"top": ("block", point)}, progress=False)
+
+
+def test_doubtful_values_are_warned_about():
+    """A residual friction angle above the peak one, a contact tolerance of the blocks' size and
+    free rocking without gravity run, with a warning that says why they are doubtful."""
+    with pytest.warns(UserWarning, match="residual_friction_angle = 50 deg exceeds friction_angle = 35"):
+        JointMaterial(kn=1e9, friction_angle=35, residual_friction_angle=50)
+    b = _builder()
+    b.add_box(0.2, 0.5, 1.0, density=2000, name="block")
+    with pytest.warns(UserWarning, match="contact_tolerance = 0.5 m exceeds half the smallest block dimension"):
+        b.finalize(contact_tolerance=0.5)
+    data = example_case("free-rocking")
+    data["specimen"]["gravity"] = 0.0
+    with pytest.warns(UserWarning, match="gravity = 0: nothing brings the tilted blocks back"):
+        parse_case(data)
+
+
+def test_an_empty_override_removes_a_key_and_only_an_existing_one():
+    """``--set loading.scale=`` removes the case's scale, so that pga_g can replace it (the two are
+    exclusive and there was no way to drop one from the command line)."""
+    from rockdem.case import apply_overrides
+
+    data = {"loading": {"type": "earthquake", "record": "elcentro-rsn6", "scale": 2.0}}
+    out = apply_overrides(data, ["loading.pga_g=0.3", "loading.scale="])
+    assert out["loading"] == {"type": "earthquake", "record": "elcentro-rsn6", "pga_g": 0.3}
+    assert data["loading"]["scale"] == 2.0  # the case itself is left alone
+    with pytest.raises(ValueError, match="an empty value removes a key, and the case has no loading.tail"):
+        apply_overrides(data, ["loading.tail="])
