@@ -237,7 +237,9 @@ class Checkpoint:
                 data = {k: z[k] for k in z.files}
             meta = json.loads(str(data.pop("meta")))
         except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:  # truncated or empty files too
-            raise ValueError(f"{p} is not a rockdem checkpoint (.npz written by rockdem run or simulate): {exc}") from None
+            # (NumPy reads a file that is no .npz as a pickle, which it refuses with advice to load it unsafely)
+            why = "not an .npz archive" if "pickle" in str(exc) else str(exc)
+            raise ValueError(f"{p} is not a rockdem checkpoint (.npz written by rockdem run or simulate): {why}") from None
         if meta.get("format") != FORMAT:
             raise ValueError(f"{p} is not a rockdem checkpoint (format {meta.get('format')!r})")
         if meta.get("version") != FORMAT_VERSION:

@@ -649,7 +649,7 @@ def _plot(args: argparse.Namespace) -> int:
         if args.output and len(kinds) == 1:
             out = Path(args.output)
         else:
-            suffix = Path(args.output).suffix if args.output else f".{args.format}"
+            suffix = (Path(args.output).suffix if args.output else "") or f".{args.format}"
             base = Path(args.output).with_suffix("") if args.output else first.with_suffix("")
             out = base.parent / f"{base.name}_{kind}{suffix}"
         written.append(save_figure(fig, out, dpi=args.dpi))

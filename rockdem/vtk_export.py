@@ -265,7 +265,7 @@ def _export(args: argparse.Namespace) -> int:
         p = export_vtk(ds, out, every=every, contacts=not args.no_contacts)
         shown = len(range(0, n, every))
         dt = float(np.median(np.diff(ds.time.values))) * every if n > 1 else 0.0
-        note = "" if every == 1 else f" (every {every}th, {dt:.3g} s apart; --every 1 for all)"
+        note = "" if every == 1 else f" (one in {every}, {dt:.3g} s apart; --every 1 for all)"
         print(f"rockdem export: wrote {shown} of {n} frames{note} to {p} (open it in ParaView)")
         if "contact_time" not in ds.coords and not args.no_contacts:
             print("rockdem export: no contact snapshots in this result: run the case with [run] contact_interval "

@@ -374,6 +374,10 @@ def test_every_command_checks_its_output_path_and_input_files(tmp_path, capsys):
         for flag in ("--from", "--settled"):
             assert main(["run", "--example", "free-rocking", flag, str(tmp_path / bad), "--out", str(tmp_path / "o2"), "--quiet"]) == 2
             assert "is not a rockdem checkpoint" in capsys.readouterr().err
+    (tmp_path / "case.toml").write_text("[run]\nduration = 1.0\n")  # a case file given as a checkpoint
+    assert main(["run", "--example", "free-rocking", "--from", str(tmp_path / "case.toml"), "--out", str(tmp_path / "o3"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "is not a rockdem checkpoint" in err and "not an .npz archive" in err and "pickle" not in err
     xr.Dataset({"a": ("t", np.arange(3.0))}).to_netcdf(tmp_path / "other.nc")
     assert main(["plot", str(tmp_path / "other.nc")]) == 2
     assert "other.nc is not a rockdem result" in capsys.readouterr().err
@@ -486,3 +490,33 @@ def test_the_plot_process_passes_its_warnings_on(tmp_path, monkeypatch):
         with pytest.warns(UserWarning, match="No artists with labels found to put in legend"):
             assert plotter.draw(series, tmp_path / "p.png") == tmp_path / "p.png"
     assert (tmp_path / "p.png").stat().st_size > 1000
+
+
+def test_records_plot_reads_a_file_with_the_options_its_advice_names(tmp_path, capsys):
+    """A two-column file without units: the error names --units (it advised a keyword argument the
+    command did not have), and with --units g the record is plotted."""
+    rec = tmp_path / "rec.txt"
+    rec.write_text("".join(f"{0.01 * k:.2f} {0.1 * np.sin(k):.5f}\n" for k in range(200)))
+    assert main(["records", "--plot", str(rec), "-o", str(tmp_path / "r.png")]) == 2
+    assert "--units" in capsys.readouterr().err
+    assert main(["records", "--plot", str(rec), "--units", "g", "-o", str(tmp_path / "r.png")]) == 0
+    assert (tmp_path / "r.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_a_run_stopped_at_collapse_does_not_read_as_no_collapse():
+    """A column stopped when its top block fell: the analysed block, which did not pass its own
+    eta, reports "overturned no" with a note that the run stopped at collapse (it read as a plain
+    "no" beside the STOPPED line)."""
+    import xarray as xr
+
+    from rockdem.run_cli import _analysis_lines
+
+    t = np.linspace(0.0, 1.0, 101)
+    theta = np.stack([0.3 * t, 0.1 * t], axis=1)  # both below their eta of 0.5 rad
+    ds = xr.Dataset({"rocking_angle": (("time", "block"), theta), "block_free": ("block", [True, True]),
+                     "block_eta": ("block", [0.5, 0.5]), "block_name": ("block", ["b1", "b2"])}, coords={"time": t})
+    rows = {line.split()[0]: line for line in _analysis_lines(ds, 0)}
+    assert rows["overturned"].split()[1] == "no" and "collapse" not in rows["overturned"]
+    ds.attrs.update(stop_reason="fell", stop_block="b2", stop_time=1.0)
+    rows = {line.split()[0]: line for line in _analysis_lines(ds, 0)}
+    assert "no" in rows["overturned"] and "the run stopped at collapse (block 'b2' fell)" in rows["overturned"]

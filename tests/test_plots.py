@@ -74,6 +74,10 @@ def test_plot_all_writes_the_plots_that_apply_and_says_which_it_skipped(result_f
     out = capsys.readouterr().out
     assert result_files["pushover"].with_name("pushover_capacity.png").exists()
     assert "skipped restitution: " in out and "skipped bouncing: " in out
+    # -o without a suffix names the files with the format's (it made "plots_history" and refused it)
+    stem = result_files["pushover"].with_name("named")
+    assert main(["plot", str(result_files["pushover"]), "--kind", "all", "-o", str(stem)]) == 0
+    assert stem.with_name("named_capacity.png").read_bytes()[:4] == b"\x89PNG"
 
 
 def _rod_pushover(b: float, h: float, z: float, duration: float):
