@@ -208,7 +208,8 @@ def apply_earthquake(
         raise ValueError(f"earthquake delay must be >= 0 s, got {delay!r}")
     if not (math.isfinite(tail) and tail >= 0.0):
         raise ValueError(f"earthquake tail must be >= 0 s, got {tail!r}")
-    if not (math.isfinite(substeps) and float(substeps).is_integer() and 1 <= substeps <= MAX_SUBSTEPS):
+    if (isinstance(substeps, bool) or not isinstance(substeps, (int, float, np.integer, np.floating))
+            or not (math.isfinite(substeps) and float(substeps).is_integer() and 1 <= substeps <= MAX_SUBSTEPS)):
         raise ValueError(f"substeps must be an integer from 1 to {MAX_SUBSTEPS}, got {substeps!r} (the foundation's "
                          "velocity differs from the exact integral by O(1/substeps^2): the default 16 suffices)")
     gm = prepare_record(motion, scale=scale, pga=pga, direction=direction, vertical=vertical,

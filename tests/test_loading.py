@@ -53,7 +53,7 @@ def test_earthquake_tables_are_bounded_before_they_are_built():
     bld = _block_builder(0.2, 1.0, 0.5, points=2, kn=1e9, ground="ground")
     with pytest.raises(ValueError, match="input table would have .* the tail of 20000 s included, 16 substeps each.*shorten the tail"):
         apply_earthquake(bld, gm, tail=2e4)
-    for substeps in (0, 2000, 2.5, math.nan):
+    for substeps in (0, 2000, 2.5, math.nan, "16", True):
         with pytest.raises(ValueError, match="substeps must be an integer from 1 to 1024"):
             apply_earthquake(bld, gm, substeps=substeps)
     with pytest.raises(ValueError, match="earthquake tail must be >= 0 s"):
