@@ -34,6 +34,7 @@ import signal
 import sys
 import threading
 import time as _time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Iterator, Mapping, NamedTuple, Sequence
@@ -256,6 +257,8 @@ def run_model(
     if start is not None and initial is not None:
         raise ValueError("give start (a prepared fresh start) or initial (a checkpoint), not both")
     ck = None if initial is None else load_checkpoint(initial)
+    with _deferred_signals(note="rockdem: stopping once the compiled kernels are loaded (a first run compiles them)"):
+        _load_kernels(n_threads)
     wall0 = _time.perf_counter()
     # A stop signal while the start's kernels load (or compile, minutes on a first run) is held until
     # they are ready: raised inside Numba's compiler it left a half-built kernel and a traceback.
@@ -642,6 +645,32 @@ PARALLEL_MIN_BLOCKS = 200
 """Models with at least this many blocks run the joint law on all of Numba's threads by default
 (``threads`` of :func:`simulate`); smaller ones run serially (a step of a few blocks is shorter
 than waking the threads)."""
+
+
+_KERNELS_LOADED: set[int] = set()
+"""The thread counts whose start and step kernels this process has loaded (:func:`_load_kernels`)."""
+
+
+def _load_kernels(threads: int) -> None:
+    """Load the compiled kernels of a model's start and of its steps on ``threads`` threads, once
+    per process, by running a block on a foundation for a few steps: from Numba's cache this takes
+    0.1 to 0.8 s (compiled on an empty cache, minutes), which the first run's ``runtime_s`` and
+    ``kernel_s`` counted before 2026-11-29 (the first of 400 equal runs of a sweep 3.4 times the
+    others, the SP/MP ratios of a study's first case off by as much). Every model has the same
+    array types, so one load serves them all."""
+    if threads in _KERNELS_LOADED:
+        return
+    _KERNELS_LOADED.add(threads)  # first: the run below would come here again
+    from .materials import JointMaterial
+    from .model import ModelBuilder
+
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e8)
+    b.add_box(1.0, 1.0, 0.2, base_center=(0.0, 0.0, -0.2), driven=True, name="foundation")
+    b.add_box(0.2, 0.3, 0.5, density=2000.0, name="block")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an undamped model is warned about
+        run_model(b.finalize(), 1e-3, record_interval=1e-3, progress=False, threads=threads)
 
 
 def _threads(threads: int | None, blocks: int) -> int:
