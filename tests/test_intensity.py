@@ -10,7 +10,7 @@ import pytest
 from rockdem.case import example_case, parse_case
 from rockdem.intensity import input_intensity, intensity_measures, response_spectrum, rocking_period
 from rockdem.loading import earthquake_record
-from rockdem.records import STANDARD_GRAVITY
+from rockdem.records import STANDARD_GRAVITY, read_record, record_path
 
 A = 2.0  # m/s^2
 F = 1.0  # Hz
@@ -65,3 +65,26 @@ def test_scaled_record_intensities_are_those_computed_directly():
             assert getattr(scaled, name) == pytest.approx(getattr(direct, name), rel=1e-9)
     lo, hi = input_intensity({**load, "scale": 1.0}, 2.3), input_intensity({**load, "scale": 3.0}, 2.3)
     assert hi.arias_m_s == pytest.approx(9 * lo.arias_m_s, rel=1e-12) and hi.sa_g == pytest.approx(3 * lo.sa_g, rel=1e-12)
+
+
+def test_spectral_acceleration_against_an_independent_integration():
+    """Sa of El Centro against SciPy's lsim of the oscillator driven by the piecewise-linear record,
+    read at 100 points per record interval: within 0.3 % at T = 6, 10 and 50 record intervals
+    (reading the response at the record's own samples only was 1.3 % and 2.3 % low at 0.06 and
+    0.1 s, the peak between samples missed). A damping given in percent and a non-finite period
+    are refused."""
+    from scipy import signal
+
+    gm = read_record(record_path("elcentro-rsn6"))
+    a, dt = gm.acceleration, gm.dt
+    fine = 100
+    tt = np.arange((a.size - 1) * fine + 1) * dt / fine
+    af = np.interp(tt, np.arange(a.size) * dt, a)
+    for period in (6 * dt, 10 * dt, 50 * dt):
+        w = 2 * np.pi / period
+        _, y, _ = signal.lsim(signal.lti([-1.0], [1.0, 0.1 * w, w * w]), af, tt)
+        assert response_spectrum(a, dt, [period])[0] == pytest.approx(w * w * np.abs(y).max(), rel=3e-3)
+    with pytest.raises(ValueError, match="damping is a ratio"):
+        response_spectrum(a, dt, [1.0], damping=5.0)
+    with pytest.raises(ValueError, match="periods must be positive finite"):
+        response_spectrum(a, dt, [np.inf])
