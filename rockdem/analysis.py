@@ -15,6 +15,7 @@ Definitions:
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -104,6 +105,15 @@ class Bouncing:
     max_magnitude: float
 
 
+def _scalar(value: Any, what: str, *, positive: bool = False) -> float:
+    """``value`` as a finite float >= 0 (> 0 with ``positive``), or ValueError naming ``what``."""
+    ok = not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+    v = float(value) if ok else math.nan
+    if not (math.isfinite(v) and (v > 0 if positive else v >= 0)):
+        raise ValueError(f"{what} must be a finite number {'> 0' if positive else '>= 0'}, got {value!r}")
+    return v
+
+
 def _history(t: ArrayLike, x: ArrayLike, name: str = "x") -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Validate a history: 1-D, same length, finite, strictly increasing time."""
     t = np.asarray(t, dtype=float)
@@ -143,6 +153,7 @@ def half_cycle_peaks(
     a = np.abs(x)
     if min_prominence is None:
         min_prominence = 1e-3 * float(a.max())
+    min_prominence = _scalar(min_prominence, "half_cycle_peaks: min_prominence")
     padded = np.concatenate(([0.0], a))  # lets a release at t[0] count as a peak
     idx = prominent_peaks(padded, max(min_prominence, np.finfo(float).tiny)) - 1
     times, values = t[idx].copy(), x[idx].copy()
@@ -226,8 +237,13 @@ def apparent_restitution(peaks: ArrayLike, theta0: float, eta: float, *, exact: 
     Raises:
         ValueError: eta not in (0, pi/2), or theta0 not in (0, eta).
     """
+    if isinstance(peaks, HalfCyclePeaks):
+        raise ValueError("apparent_restitution: give the peak values after the release, e.g. "
+                         "half_cycle_peaks(t, theta).value[1:], not the HalfCyclePeaks result itself")
     if not (0.0 < eta < 0.5 * np.pi):
         raise ValueError(f"eta must be the slenderness angle in (0, pi/2) rad, got {eta!r}")
+    if np.ndim(peaks) > 1:
+        raise ValueError(f"apparent_restitution: peaks must be a 1-D array of peak rotations, got shape {np.shape(peaks)}")
     th0 = abs(float(theta0))
     if not (0.0 < th0 < eta):
         raise ValueError(f"theta0 must lie in (0, eta = {eta:.6g}) rad, got {theta0!r} (a release beyond eta overturns)")
@@ -259,8 +275,8 @@ def rest_time(t: ArrayLike, x: ArrayLike, *, rest_tol: float | None = None) -> f
     t, x = _history(t, x, "rest_time")
     dev = np.abs(x - x[-1])
     tol = 0.01 * float(dev.max()) if rest_tol is None else float(rest_tol)
-    if tol < 0:
-        raise ValueError(f"rest_tol must be >= 0, got {rest_tol!r}")
+    if not (math.isfinite(tol) and tol >= 0):
+        raise ValueError(f"rest_tol must be a finite threshold >= 0 (unit of the history), got {rest_tol!r}")
     moving = np.flatnonzero(dev > tol)
     if len(moving) == 0:
         return float(t[0])
@@ -305,6 +321,9 @@ def wme(
     ts, xs = _history(t_sim, x_sim, "wme simulation")
     t_end = rest_time(tr, xr, rest_tol=rest_tol) if cut_at_rest else float(tr[-1])
     keep = tr <= t_end
+    if np.count_nonzero(keep) < 2:
+        raise ValueError(f"wme: the reference never moves by more than rest_tol = {rest_tol!r} from its end value, so "
+                         "the cut at rest leaves nothing to compare; lower rest_tol or pass cut_at_rest=False")
     inside = keep & (tr >= ts[0]) & (tr <= ts[-1])
     if not np.any(inside):
         raise ValueError("wme: the simulation does not overlap the reference in time")
@@ -331,6 +350,7 @@ def rocking_lift(theta: ArrayLike, b: float, h: float) -> NDArray[np.float64]:
     z_c(theta) - z_c(0) = R [cos(eta - |theta|) - cos(eta)], R = semi-diagonal, eta = atan(b/h).
     Subtract it from a centroid height history to keep only the airborne part for :func:`bouncing`.
     """
+    b, h = _scalar(b, "rocking_lift: b [m]", positive=True), _scalar(h, "rocking_lift: h [m]", positive=True)
     r = 0.5 * np.hypot(b, h)
     eta = np.arctan2(b, h)
     th = np.abs(np.asarray(theta, dtype=float))
@@ -370,14 +390,14 @@ def bouncing(
     t, z = _history(t, z, "bouncing")
     if z_contact is not None:
         base = np.asarray(z_contact, dtype=float)
-        if base.shape != z.shape:
-            raise ValueError(f"bouncing: z_contact must have the shape of z {z.shape}, got {base.shape}")
+        if base.shape != z.shape or not np.all(np.isfinite(base)):
+            raise ValueError(f"bouncing: z_contact must be finite, of the shape of z {z.shape}, got {base.shape}")
     else:
+        if z_rest is not None and not (isinstance(z_rest, (int, float, np.integer, np.floating)) and math.isfinite(z_rest)):
+            raise ValueError(f"bouncing: z_rest must be a finite height [m], got {z_rest!r}")
         base = np.full_like(z, z[0] if z_rest is None else float(z_rest))
     d = z - base
-    tol = 1e-5 if tol is None else float(tol)
-    if tol <= 0:
-        raise ValueError(f"bouncing: tol must be > 0 m, got {tol!r}")
+    tol = 1e-5 if tol is None else _scalar(tol, "bouncing: tol [m]", positive=True)
     air = d > tol
     edges = np.diff(air.astype(np.int8))
     starts = list(np.flatnonzero(edges == 1) + 1)
@@ -429,8 +449,7 @@ def residual_drift(t: ArrayLike, x: ArrayLike, *, tail: float = 0.0) -> float:
         tail: averaging window at the end [s], >= 0.
     """
     t, x = _history(t, x, "residual_drift")
-    if tail < 0:
-        raise ValueError(f"residual_drift: tail must be >= 0 s, got {tail!r}")
+    tail = _scalar(tail, "residual_drift: tail [s]")
     sel = t >= t[-1] - tail
     return float(np.mean(x[sel]))
 
@@ -479,7 +498,7 @@ def first_impact_time(t: ArrayLike, theta: ArrayLike, threshold: float | None = 
         threshold: rotation that counts as rocking [rad]; default 1 % of max |theta|.
     """
     t, th = _history(t, theta, "first_impact_time")
-    thr = 0.01 * float(np.abs(th).max()) if threshold is None else float(threshold)
+    thr = 0.01 * float(np.abs(th).max()) if threshold is None else _scalar(threshold, "first_impact_time: threshold [rad]", positive=True)
     above = np.flatnonzero(np.abs(th) > thr)
     if not len(above):
         return None
@@ -545,6 +564,8 @@ def summarize(
         dict of scalars; absent measurements are omitted, a never-reached onset is None.
     """
     t, th = _history(t, theta, "summarize")
+    if eta is not None:
+        eta = _scalar(eta, "summarize: eta [rad]", positive=True)
     out: dict[str, Any] = {
         "max_rotation_rad": max_rotation(th),
         "residual_rad": residual_drift(t, th),

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ._warn import warn_user
 from .analysis import wme
 from .plots import save_figure
 from .case import parse_assignment
@@ -66,6 +67,8 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         raise FileNotFoundError(f"reference {p} does not exist")
     if quantity not in QUANTITIES:
         raise ValueError(f"quantity must be one of {QUANTITIES}, got {quantity!r}")
+    if isinstance(column, bool) or not isinstance(column, (int, np.integer)) or column < 1:
+        raise ValueError(f"reference column must be 1 or more (zero-based; column 0 holds the time), got {column!r}")
     if p.suffix == ".nc":
         from .plots import read_result_file
 
@@ -91,6 +94,7 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
     lines = [line.split("#", 1)[0].strip() for line in text.splitlines()]
     split = _splitter([line for line in lines if line])
     rows, widths = [], set()
+    nonfinite = 0
     for line in lines:
         try:
             values = [float(f) for f in split(line)]
@@ -99,6 +103,10 @@ def load_reference(path: str | os.PathLike[str], *, quantity: str = "rotation", 
         if values and all(math.isfinite(v) for v in values):
             widths.add(len(values))
             rows.append(values)
+        elif values:
+            nonfinite += 1
+    if nonfinite:
+        warn_user(f"reference {p}: {nonfinite} row(s) with NaN or infinite values left out")
     if rows and min(widths) <= column:
         raise ValueError(f"reference {p}: {need}; found {min(widths)} column(s)")
     if len(rows) < 2:
@@ -204,7 +212,7 @@ def calibrate(
     base: str | Mapping[str, Any],
     parameters: str | Sequence[str],
     bounds: Sequence[float] | Sequence[Sequence[float]],
-    reference: Reference,
+    reference: Reference | str | os.PathLike[str],
     *,
     fixed: Mapping[str, Any] | None = None,
     duration: float | None = None,
@@ -244,15 +252,27 @@ def calibrate(
     """
     from scipy.optimize import minimize, minimize_scalar
 
+    if isinstance(reference, (str, os.PathLike)):
+        reference = load_reference(reference)
+    if not isinstance(reference, Reference):
+        raise ValueError(f"reference must be a Reference (load_reference) or a file path, got {type(reference).__name__}")
     keys = [parameters] if isinstance(parameters, str) else list(parameters)
-    bnds = [tuple(map(float, bounds))] if isinstance(parameters, str) else [tuple(map(float, b)) for b in bounds]
+    try:
+        bnds = [tuple(map(float, bounds))] if isinstance(parameters, str) else [tuple(map(float, b)) for b in bounds]
+    except (TypeError, ValueError):
+        bnds = []
     if len(bnds) != len(keys) or any(len(b) != 2 or not b[1] > b[0] for b in bnds):
-        raise ValueError(f"bounds: give one (low, high) pair with low < high per parameter, got {bounds!r}")
+        raise ValueError(f"bounds: give one (low, high) pair with low < high per parameter ({len(keys)} parameter(s): "
+                         f"{keys}), got {bounds!r}")
     if log and any(b[0] <= 0 for b in bnds):
         raise ValueError("log search needs positive bounds (use log=False for a parameter that may be 0)")
     base_d = resolve_base(base)
     if stop not in ("rest", "off"):
         raise ValueError(f"calibrate: stop must be 'rest' or 'off', got {stop!r} (a run stopped as collapsed has no history to compare)")
+    both = sorted(set(keys) & set(fixed or {}))
+    if both:
+        raise ValueError(f"calibrate: {both} both calibrated and fixed (--set): the fixed value would be ignored; "
+                         "leave the parameter out of the fixed overrides")
     fixed = with_stop(fixed, stop)
     # the duration: given, else a fixed run.duration, else the reference's last time
     dur = float(duration) if duration is not None else None if "run.duration" in fixed else float(reference.time[-1])
@@ -409,8 +429,7 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
         print(f"rockdem calibrate: stopped; {store.kept() if store is not None else 'give --out to keep finished runs'}",
               file=sys.stderr)
         raise
-    print(res.report())
-    if out is not None:
+    if out is not None:  # the files first: a closed standard output must not lose them
         out.mkdir(parents=True, exist_ok=True)
         res.evaluations.to_csv(out / "evaluations.csv", index=False)
         if res.curve is not None:
@@ -418,6 +437,7 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
             plot_calibration(res, ref, out / "wme.png")
         (out / "calibration.json").write_text(json.dumps(res.to_json(), indent=2))
         (out / "report.txt").write_text(res.report() + "\n")
+    print(res.report())
     return 1 if res.failed else 0  # as a sweep with failed runs
 
 

@@ -12,6 +12,7 @@ import contextlib
 import gc
 import importlib
 import math
+import os
 import signal
 import sys
 import tempfile
@@ -40,6 +41,8 @@ _COMMAND_MODULES = tuple(dict.fromkeys(_COMMANDS.values()))
 
 EXIT_BAD_INPUT = 2
 EXIT_DIVERGED = 3
+EXIT_BROKEN_PIPE = 128 + 13
+"""Standard output closed by its reader (SIGPIPE's status in a shell)."""
 STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
 """Signals that stop a run or a study like Ctrl-C: the work done so far is saved."""
 
@@ -279,6 +282,17 @@ def _main(argv: list[str] | None) -> int:
             return int(args.func(args) or 0)
     except (ValueError, FileNotFoundError) as exc:
         print(f"rockdem {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:  # the reader of the output left (| head); the commands write their files first
+        try:
+            sys.stdout = open(os.devnull, "w")  # no second error as Python flushes the closed pipe at exit
+        except OSError:
+            pass
+        print(f"rockdem {args.command}: standard output closed by its reader (as with | head)", file=sys.stderr)
+        return EXIT_BROKEN_PIPE
+    except (TimeoutError, ConnectionError) as exc:  # a Dask scheduler that does not answer (OSError subclasses)
+        print(f"rockdem {args.command}: error: {exc}; check the address given (--scheduler) and that it is running",
+              file=sys.stderr)
         return EXIT_BAD_INPUT
     except OSError as exc:  # a file or folder the command could not read or write
         where = f"{exc.filename}: " if exc.filename else ""

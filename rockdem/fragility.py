@@ -20,6 +20,7 @@ the input spectra and a ``report.md`` that shows them.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from collections.abc import Callable, Mapping, Sequence
@@ -96,8 +97,13 @@ def fit_fragility_mle(im: Sequence[float], failed_: Sequence[bool] | Sequence[in
     n = np.ones_like(x) if trials is None else np.asarray(trials, dtype=float)
     if x.shape != z.shape or x.shape != n.shape or x.ndim != 1 or len(x) < 2:
         raise ValueError("fit_fragility_mle: give equal-length 1-D arrays with at least 2 entries")
-    if np.any(x <= 0):
-        raise ValueError("fit_fragility_mle: intensities must be > 0")
+    if not np.all(np.isfinite(x)) or np.any(x <= 0):
+        raise ValueError("fit_fragility_mle: intensities must be finite and > 0")
+    if not np.all(np.isfinite(n)) or np.any(n < 1) or np.any(n != np.round(n)):
+        raise ValueError("fit_fragility_mle: trials must be whole numbers >= 1")
+    if not np.all(np.isfinite(z)) or np.any(z != np.round(z)) or np.any(z < 0) or np.any(z > n):
+        raise ValueError("fit_fragility_mle: outcomes must be 0 or 1 per analysis (failure counts from 0 to the "
+                         "trials per group)")
     if z.sum() == 0 or z.sum() == n.sum():
         raise ValueError("fit_fragility_mle: need both failures and survivals to fit a fragility")
     lx = np.log(x)
@@ -110,7 +116,8 @@ def fit_fragility_mle(im: Sequence[float], failed_: Sequence[bool] | Sequence[in
     # start: median where half the analyses fail, dispersion from the spread of intensities
     p0 = np.array([float(np.sum(lx * n) / n.sum()), np.log(max(float(np.std(lx)), 0.1))])
     res = minimize(nll, p0, method="Nelder-Mead", options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000})
-    return Fragility(float(np.exp(res.x[0])), float(np.exp(res.x[1])), int(n.sum()))
+    sep = bool(x[z < n].max() <= x[z > 0].min())  # every level with a failure at or above every one with a survival
+    return Fragility(float(np.exp(res.x[0])), float(np.exp(res.x[1])), int(n.sum()), separated=sep)
 
 
 def fit_fragility_capacities(capacities: Sequence[float]) -> Fragility:
@@ -148,6 +155,9 @@ def failed(table: pd.DataFrame, drift_limit: float | None = None) -> pd.Series:
     fallen at its end (``fallen_blocks`` > 0: partial collapse counts, as the "fell" stop does;
     tables from before 2026-11-28 have no such column), or peak rotation > drift_limit x eta (a
     nullable boolean: <NA> for runs without an outcome, see :func:`completed`)."""
+    if drift_limit is not None and (isinstance(drift_limit, bool) or not isinstance(drift_limit, (int, float, np.number))
+                                    or not (math.isfinite(drift_limit) and drift_limit > 0)):
+        raise ValueError(f"drift_limit must be a positive multiple of eta (e.g. 0.5), got {drift_limit!r}")
     done = completed(table)
     f = pd.Series(pd.NA, index=table.index, dtype="boolean")
     if done.any():
@@ -330,6 +340,7 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
         raise ValueError(f"period must be a positive time [s], got {period!r}")
     if isinstance(records, str) or len(records) == 0 or len(pga_g) == 0:
         raise ValueError(f"give a list of at least one record and one PGA level [g], got records={records!r}, pga_g={pga_g!r}")
+    failed(pd.DataFrame({"overturned": []}), drift_limit)  # drift_limit checked before any run
     specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration, stop=stop)
     _check_cases(specs, len(pga_g))
     notes = _cut_short(specs[::len(pga_g)])

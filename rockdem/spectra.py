@@ -58,7 +58,13 @@ class Spectrum:
                 f"damping {self.damping:g}, peak PSA {self.psa[k]:.4g} m/s^2 at T = {self.period[k]:.3g} s)")
 
     def at(self, period: float) -> float:
-        """PSA [m/s^2] at ``period`` [s] (log-log interpolation between the computed periods)."""
+        """PSA [m/s^2] at ``period`` [s] (log-log interpolation between the computed periods; a
+        period outside them is refused: the end value would be returned for it)."""
+        lo, hi = float(self.period.min()), float(self.period.max())
+        if isinstance(period, bool) or not isinstance(period, (int, float, np.integer, np.floating)) \
+                or not lo * (1 - 1e-12) <= period <= hi * (1 + 1e-12):
+            raise ValueError(f"Spectrum.at: period must lie within the computed {lo:g} to {hi:g} s, got {period!r}; "
+                             "compute the spectrum at it (response_spectrum(motion, periods))")
         return float(np.exp(np.interp(np.log(period), np.log(self.period), np.log(self.psa))))
 
 
@@ -83,6 +89,9 @@ def response_spectrum(
     """
     import pyrotd
 
+    if not isinstance(motion, GroundMotion):
+        raise ValueError(f"response_spectrum: motion must be a GroundMotion (rockdem.records.read_record, or "
+                         f"GroundMotion(acceleration, dt)), got {type(motion).__name__}")
     t = DEFAULT_PERIODS if periods is None else np.asarray(periods, dtype=float).reshape(-1)
     if t.size == 0 or not np.all(np.isfinite(t) & (t > 0)):
         raise ValueError(f"spectrum periods must be positive times [s], got {periods!r}")

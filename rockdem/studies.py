@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ._warn import warn_user
 from .cli import integer_at_least, output_folder, positive_float, positive_int, stop_on_signals
 from .case import MAX_MAGNITUDE, apply_overrides, check_plausible, example_case, example_names, load_case, parse_case, read_toml
 
@@ -492,6 +493,15 @@ def execute(
     unique: dict[str, RunSpec] = {}
     for s in specs:
         unique.setdefault(s.id, s)
+    if len(unique) < len(specs):
+        seen: set[str] = set()
+        for twice in specs:  # the first run that repeats an earlier one
+            if twice.id in seen:
+                break
+            seen.add(twice.id)
+        warn_user(f"{len(specs) - len(unique)} of the {len(specs)} runs repeat another run's settings and are run once "
+                  f"(the first: {_describe(twice)}); a repeated value in a grid, a list or the levels and records of "
+                  "an IDA adds no run")
     st = Store(store) if store is not None and not isinstance(store, Store) else store
     stored = {r["id"]: r for r in st.rows()} if st is not None else {}
     done = {i for i, r in stored.items() if r.get("status") in FINISHED}
@@ -598,6 +608,8 @@ def expand_list(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     """Explicit variations, one mapping per run."""
     if isinstance(rows, (str, bytes, Mapping)) or not isinstance(rows, Sequence):
         raise ValueError(f"list: give a list of tables of \"table.key\" = value, got {rows!r}"[:200])
+    if len(rows) == 0:
+        raise ValueError("list: no rows; give at least one table of \"table.key\" = value (one per run)")
     _run_count(len(rows), "list")
     out = []
     for r in rows:
@@ -627,6 +639,10 @@ def expand_random(ranges: Mapping[str, Any], n: int, seed: int) -> list[dict[str
             idx = rng.integers(0, len(choices), size=n)
             vals = [choices[i] for i in idx]
         else:
+            extra = sorted(set(r) - {"low", "high", "log"}) if isinstance(r, Mapping) else []
+            if extra:
+                raise ValueError(f"random parameter {key!r}: unknown key(s) {extra}; a range takes low, high and log "
+                                 "(or choices alone)")
             try:
                 lo, hi, log = (r["low"], r["high"], r.get("log", False)) if isinstance(r, Mapping) else (*r, False)
                 if isinstance(r, (str, bytes)) or isinstance(lo, bool) or isinstance(hi, bool):
@@ -804,14 +820,38 @@ def _add_exec_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+CHECKED_RUNS = 64
+"""Most runs whose cases :func:`check_first_run` builds before a study starts."""
+
+
 def check_first_run(specs: Sequence[RunSpec], what: str = "the study") -> None:
-    """Build the first run's case (no simulation) so that a bad base case or override is refused
-    before any run starts, instead of ending as one error row per run."""
-    if specs:
+    """Build the cases (no simulation) of the first run and of each run that brings a value no
+    run before it had (up to CHECKED_RUNS of them), so that a bad base case, override or grid value
+    is refused before any run starts, instead of ending as error rows (before 2026-11-29 only the
+    first run was built: a grid [0.002, -0.002] failed at its second run)."""
+    seen: set[tuple[str, str]] = set()
+    checked = 0
+    for k, spec in enumerate(specs):
+        values = {(key, repr(v)) for key, v in spec.overrides} | {("record", repr(spec.record)), ("pga_g", repr(spec.pga_g))}
+        if k > 0 and values <= seen:
+            continue
+        seen |= values
         try:
-            parse_case(specs[0].case_dict())
+            parse_case(spec.case_dict())
         except (ValueError, FileNotFoundError) as exc:
-            raise ValueError(f"{what}'s first run is not a valid case: {exc}") from None
+            which = "first run" if k == 0 else f"run {k + 1} ({_describe(spec)})"
+            raise ValueError(f"{what}'s {which} is not a valid case: {exc}") from None
+        checked += 1
+        if checked >= CHECKED_RUNS:
+            return
+
+
+def _describe(spec: RunSpec) -> str:
+    """A run's settings in a line: its overrides, record and PGA."""
+    parts = [f"{k} = {v!r}" for k, v in spec.overrides if k != "run.stop"]
+    parts += [f"record {spec.record!r}"] if spec.record is not None else []
+    parts += [f"pga_g = {spec.pga_g:g}"] if spec.pga_g is not None else []
+    return ", ".join(parts) or "the base case"
 
 
 def _sweep(args: argparse.Namespace) -> int:

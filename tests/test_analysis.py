@@ -18,6 +18,7 @@ from rockdem.analysis import (
     apparent_restitution,
     bouncing,
     fallen_blocks,
+    first_impact_time,
     half_cycle_peaks,
     lowest_point_height,
     max_rotation,
@@ -87,6 +88,13 @@ def test_wme_errors() -> None:
         wme(T, X, T[:1000], X[:1000], cut_at_rest=False)
     with pytest.warns(UserWarning, match="covers"):
         wme(T, X, T[:1000], X[:1000], cut_at_rest=False, overlap_only=True)
+    # a threshold that leaves the reference "at rest" from its start compared one sample: WME 0, a
+    # perfect match of two different histories
+    for tol in (np.nan, np.inf):
+        with pytest.raises(ValueError, match="rest_tol must be a finite threshold"):
+            wme(T, X, T, 0.5 * X, rest_tol=tol)
+    with pytest.raises(ValueError, match="leaves nothing to compare"):
+        wme(T, X, T, 0.5 * X, rest_tol=10.0 * float(np.abs(X).max()))
 
 
 def test_apparent_restitution_inverts_eq_6() -> None:
@@ -433,3 +441,22 @@ def test_wme_of_a_simulation_that_does_not_cover_the_reference_is_refused():
         wme(t, x, t[:200], x[:200], cut_at_rest=False)
     with pytest.warns(UserWarning, match="outside it are ignored"):
         assert wme(t, x, t[:200], x[:200], cut_at_rest=False, overlap_only=True) == 0.0
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda t, th: apparent_restitution(half_cycle_peaks(t, th), 0.05, 0.1), r"value\[1:\], not the HalfCyclePeaks"),
+    (lambda t, th: apparent_restitution(np.full((2, 2), 0.01), 0.05, 0.1), "1-D array"),
+    (lambda t, th: residual_drift(t, th, tail=np.nan), "tail"),
+    (lambda t, th: half_cycle_peaks(t, th, min_prominence=-1.0), "min_prominence"),
+    (lambda t, th: half_cycle_peaks(t, th, min_prominence=np.nan), "min_prominence"),
+    (lambda t, th: bouncing(t, th, tol=np.nan), "tol"),
+    (lambda t, th: bouncing(t, th, z_rest=np.nan), "z_rest"),
+    (lambda t, th: first_impact_time(t, th, threshold=-1.0), "threshold"),
+    (lambda t, th: rocking_lift(0.1, -1.0, 1.0), "b"),
+    (lambda t, th: summarize(t, th, eta=-1.0), "eta"),
+])
+def test_analysis_parameters_that_would_give_a_silent_answer_are_refused(call, message):
+    """Each of these returned None, NaN, no peaks, no phases or a negative lift without a word."""
+    t = np.linspace(0.0, 1.0, 101)
+    with pytest.raises(ValueError, match=message):
+        call(t, 0.05 * np.cos(10.0 * t))

@@ -106,3 +106,24 @@ def test_failed_runs_are_counted_and_a_calibration_of_failures_is_refused(monkey
     assert any("runs failed" in n and "dt above the stable bound" in n for n in res.notes)
     with pytest.raises(ValueError, match="every run so far failed"):
         calibrate("free-rocking", "damping.beta", (2e-4, 1e-3), REF, scan_points=9, executor="serial")
+
+
+def test_a_parameter_both_calibrated_and_fixed_is_refused(synthetic) -> None:
+    """``--set damping.beta=...`` beside ``--parameter damping.beta``: the fixed value was ignored."""
+    with pytest.raises(ValueError, match=r"\['damping.beta'\] both calibrated and fixed"):
+        calibrate("free-rocking", "damping.beta", (0.001, 0.01), REF, fixed={"damping.beta": 0.003})
+
+
+def test_calibration_inputs_are_checked(synthetic, tmp_path) -> None:
+    """A reference given as a path is read; mismatched bounds, a time column given as the value
+    column and rows of NaN get a message (an AttributeError, a TypeError and silence before)."""
+    ref = tmp_path / "ref.csv"
+    ref.write_text("t,theta\n" + "".join(f"{0.1 * k:.1f},{0.01 * k}\n" for k in range(11)) + "1.1,nan\n")
+    with pytest.warns(UserWarning, match="1 row\\(s\\) with NaN or infinite values left out"):
+        res = calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), str(ref), scan_points=5, executor="serial")
+    assert 2e-4 <= res.optimum["damping.beta"] <= 5e-3
+    with pytest.raises(ValueError, match=r"one \(low, high\) pair .* \(2 parameter"):
+        calibrate("free-rocking", ["damping.beta", "damping.alpha"], (0.001, 0.01), REF)
+    for column in (0, -1):
+        with pytest.raises(ValueError, match="column must be 1 or more"):
+            cal.load_reference(ref, column=column)

@@ -520,3 +520,19 @@ def test_a_run_stopped_at_collapse_does_not_read_as_no_collapse():
     ds.attrs.update(stop_reason="fell", stop_block="b2", stop_time=1.0)
     rows = {line.split()[0]: line for line in _analysis_lines(ds, 0)}
     assert "no" in rows["overturned"] and "the run stopped at collapse (block 'b2' fell)" in rows["overturned"]
+
+
+def test_a_closed_standard_output_ends_the_command_quietly(monkeypatch, capsys):
+    """``rockdem records | head -0``: the pipe's reader left; the command says so in one line and
+    exits 141 (128 + SIGPIPE, as a shell reports it), not 2 with "check the path and its
+    permissions"."""
+    class Closed:
+        def write(self, text):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr(sys, "stdout", Closed())
+    assert main(["records"]) == 141
+    assert "standard output closed by its reader" in capsys.readouterr().err

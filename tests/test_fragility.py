@@ -11,12 +11,14 @@ from rockdem.fragility import (
     Fragility,
     _cut_short,
     collapse_capacities,
+    failed,
     fit_all,
     fit_fragility_capacities,
     fit_fragility_mle,
     ida_counts,
     ida_specs,
     run_ida,
+    separated,
     write_report,
 )
 
@@ -256,3 +258,23 @@ def test_the_ida_plot_keeps_small_rotations_apart():
     assert rotation_floor(pd.Series([0.01, 0.5])) == 1e-3
     assert rotation_floor(pd.Series([0.0, np.nan])) == 1e-3
     assert rotation_floor(pd.Series([1e-12, 0.2])) == ROTATION_FLOOR
+
+
+def test_the_mle_fit_flags_separated_outcomes_and_refuses_bad_ones():
+    """Outcomes separated by the intensity (every failure above every survival, per analysis or per
+    group) give a fit whose beta says only how far apart the levels were: the fit says so (it said
+    separated=False with beta = 0.016). Non-finite intensities and outcomes other than 0/1 (or
+    counts beyond the trials) are refused naming what is wrong, and so is a negative drift limit."""
+    sep = fit_fragility_mle([0.1, 0.2, 0.3, 0.4], [0, 0, 1, 1])
+    assert sep.separated and separated([0.1, 0.2, 0.3, 0.4], [0, 0, 1, 1])
+    mixed = fit_fragility_mle([0.1, 0.2, 0.3, 0.4], [0, 1, 0, 1])
+    assert not mixed.separated and 0.3 < mixed.beta < 3.0
+    assert not fit_fragility_mle([0.1, 0.2, 0.3], [1, 3, 4], [5, 5, 5]).separated
+    assert fit_fragility_mle([0.1, 0.2, 0.3], [0, 0, 5], [5, 5, 5]).separated
+    with pytest.raises(ValueError, match="intensities must be finite"):
+        fit_fragility_mle([0.1, np.nan, 0.3], [0, 1, 1])
+    for outcome in ([0, 2, 1], [0, -1, 1]):
+        with pytest.raises(ValueError, match="outcomes must be 0 or 1"):
+            fit_fragility_mle([0.1, 0.2, 0.3], outcome)
+    with pytest.raises(ValueError, match="drift_limit must be a positive multiple of eta"):
+        failed(pd.DataFrame({"overturned": [False]}), drift_limit=-1.0)

@@ -143,3 +143,14 @@ def test_bad_input(kwargs: dict, match: str) -> None:
         HousnerBlock(0.0, 1.0)
     with pytest.raises(ValueError, match="theta0"):
         quarter_period(SQUAT, SQUAT.eta)
+
+
+def test_housner_inputs_are_checked_and_numpy_scalars_accepted():
+    """A NumPy float is a number (np.float32 was refused); NaN or a negative rest criterion is
+    refused naming the argument (NaN ended in 'cannot convert float NaN to integer')."""
+    block = HousnerBlock(np.float32(0.2), np.int64(2))
+    assert block.eta == pytest.approx(math.atan(0.2 / 2.0), rel=1e-7) and isinstance(block.b, float)
+    for kw, name in ((dict(theta0=math.nan), "theta0"), (dict(theta0=0.05, omega0=math.inf), "omega0"),
+                     (dict(theta0=0.05, rest_amplitude=-1.0), "rest_amplitude")):
+        with pytest.raises(ValueError, match=name):
+            rock(block, duration=1.0, **kw)

@@ -92,3 +92,16 @@ def load_free_rocking():
     from viz_cases import example_result
 
     return example_result()
+
+
+def test_spectrum_reads_only_where_it_was_computed_and_takes_a_record():
+    """Spectrum.at outside its periods returned the end value (Sa at 10 s as at 5 s) or NaN; an
+    array given for the record raised an AttributeError."""
+    gm = GroundMotion(np.sin(np.linspace(0.0, 20.0, 1001)), 0.01)
+    spec = response_spectrum(gm, [0.1, 0.5, 1.0])
+    assert spec.at(0.5) == pytest.approx(spec.psa[1], rel=1e-12)
+    for period in (10.0, -1.0, 0.05):
+        with pytest.raises(ValueError, match="within the computed 0.1 to 1 s"):
+            spec.at(period)
+    with pytest.raises(ValueError, match="motion must be a GroundMotion"):
+        response_spectrum(gm.acceleration, [0.5])

@@ -390,15 +390,43 @@ def test_killed_sweep_leaves_no_worker_running(tmp_path, sig):
 
 
 def test_a_sweep_names_why_its_failed_runs_failed(tmp_path, capsys):
-    """A grid whose second row is a bad case runs the first and prints the second's error on the
-    console, not only a count (before 2026-11-29: "2 runs (1 failed, 0 diverged)", the reason only in
-    table.csv)."""
+    """A grid whose second row fails when it runs (a record interval whose frames would take 2 TB)
+    runs the first and prints the second's error on the console, not only a count (before
+    2026-11-29: "2 runs (1 failed, 0 diverged)", the reason only in table.csv). A second row that is
+    no valid case is refused before any run, naming it (it failed at its turn)."""
     from rockdem.cli import main
 
     f = tmp_path / "s.toml"
     f.write_text('[study]\nbase = "free-rocking"\nduration = 0.01\nexecutor = "serial"\n'
-                 '[study.grid]\n"specimen.width" = [0.2, -1.0]\n')
+                 '[study.grid]\n"run.record_interval" = [0.002, 1e-12]\n')
     assert main(["sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"]) == 1
     captured = capsys.readouterr()
     assert "2 runs (1 failed, 0 diverged)" in captured.out
-    assert "failed: ValueError: [specimen] width must be positive" in captured.err
+    assert "failed: ValueError: recording 10000000001 frames" in captured.err
+    f.write_text('[study]\nbase = "free-rocking"\nduration = 0.01\nexecutor = "serial"\n'
+                 '[study.grid]\n"specimen.width" = [0.2, -1.0]\n')
+    assert main(["sweep", str(f), "--out", str(tmp_path / "o2"), "--no-progress"]) == 2
+    assert "run 2 (specimen.width = -1.0) is not a valid case: [specimen] width must be positive" in capsys.readouterr().err
+    assert not (tmp_path / "o2" / "table.csv").exists()
+
+
+def test_study_inputs_that_would_run_otherwise_than_written_are_refused_or_warned(tmp_path):
+    """An empty list, a misspelt key of a random range (it sampled uniformly instead of log), and
+    a bad value of a later grid point (it failed only when its run came) are refused before any run;
+    repeated settings run once, with a warning naming them (they shrank the study silently)."""
+    from rockdem.studies import check_first_run, execute, parse_study
+
+    def study(**table):
+        return {"study": {"base": "free-rocking", "duration": 0.05, **table}}
+
+    with pytest.raises(ValueError, match="list: no rows"):
+        parse_study(study(list={"rows": []}))
+    with pytest.raises(ValueError, match=r"unknown key\(s\) \['lgo'\]"):
+        parse_study(study(random={"n": 2, "damping.beta": {"low": 0.001, "high": 0.01, "lgo": True}}))
+    specs = parse_study(study(grid={"damping.beta": [0.002, -0.002]})).specs
+    with pytest.raises(ValueError, match=r"run 2 \(damping.beta = -0.002\) is not a valid case: \[damping\] beta"):
+        check_first_run(specs)
+    twice = parse_study(study(grid={"damping.beta": [0.002, 0.002]})).specs
+    with pytest.warns(UserWarning, match=r"1 of the 2 runs repeat another run's settings .*damping.beta = 0.002"):
+        rows = execute(twice, tmp_path / "s", executor="serial", progress=False)
+    assert len(rows) == 1

@@ -19,6 +19,7 @@ import datetime as _dt
 import importlib
 import os
 import platform
+import sys
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -272,9 +273,17 @@ def _run_cli(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else (DEFAULT_REDUCED_OUT if args.reduced else DEFAULT_OUT)
     ctx = Context(out=out, cache=Path(args.cache), reduced=args.reduced, executor=args.executor or "process",
                   workers=args.workers, scheduler=args.scheduler, progress=not args.quiet)
-    for n in todo:
-        rep = run_reproduction(n, ctx)
-        print(f"rockdem reproduce {n}: {rep.runtime_s:.1f} s -> {ctx.out / (n + '.md')}")
+    from ..cli import stop_on_signals
+
+    try:
+        with stop_on_signals():  # SIGTERM and SIGHUP as Ctrl-C (it ended the command without a word)
+            for n in todo:
+                rep = run_reproduction(n, ctx)
+                print(f"rockdem reproduce {n}: {rep.runtime_s:.1f} s -> {ctx.out / (n + '.md')}")
+    except KeyboardInterrupt:
+        print(f"rockdem reproduce: stopped; the finished runs are kept in {ctx.cache} and a rerun of the same "
+              "command resumes", file=sys.stderr)
+        raise
     write_index(ctx)
     return 0
 
