@@ -93,6 +93,37 @@ def test_an_undamped_model_is_warned_about_its_ringing_joints():
     assert notes == [] and held < 1e-5  # the elastic shear deflection, a few micrometres
 
 
+@pytest.mark.parametrize("slope", [29.5, 31.0])
+def test_the_undamped_warnings_beta_holds_a_cube_below_its_friction_angle_and_slides_it_at_coulombs_rate(slope):
+    """A 0.5 m cube with 3 x 3 points on a slope, friction angle 30 deg, with the beta the warning
+    suggests: at 29.5 deg it stays (with the 5 % of critical suggested before 2026-11-29 it crept at
+    7 mm/s), at 31 deg it slides at g (sin a - tan 30 cos a) within 1 % (it slid 15 % fast)."""
+    a = math.radians(slope)
+    r = np.array([[math.cos(a), 0, math.sin(a)], [0, 1, 0], [-math.sin(a), 0, math.cos(a)]])
+
+    def build():
+        b = ModelBuilder(points=(3, 3))
+        b.default_material = JointMaterial.from_modulus(1e9, 0.5, friction_angle=30)
+        b.add_box(4, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+        b.add_box(0.5, 0.5, 0.5, density=2000, name="block")
+        b.transform_block("ground", r)
+        b.transform_block("block", r)
+        return b
+
+    with pytest.warns(UserWarning, match="no damping") as caught:
+        build().finalize()
+    hint = float(re.search(r"damping\.beta = ([0-9.e-]+) s", str(caught[0].message)).group(1))
+    ds = simulate(build().finalize(damping=Damping(beta=hint)), 2.0, record_interval=0.01, progress=False)
+    s = ds.block_displacement.sel(block="block").values @ (r @ np.array([1.0, 0.0, 0.0]))  # along the slope
+    t = ds.time.values
+    if slope < 30.0:
+        assert abs(s[-1] - s[100]) < 1e-6  # no creep from 1 to 2 s (it crept 7 mm)
+    else:
+        fit = np.polyfit(t[100:], s[100:], 2)
+        expected = 9.81 * (math.sin(a) - math.tan(math.radians(30)) * math.cos(a))
+        assert abs(2.0 * fit[0]) == pytest.approx(expected, rel=0.01)  # measured within 2e-9
+
+
 def test_the_undamped_warning_stays_quiet_for_damped_joints_and_an_undamped_case_by_choice():
     def block(material_beta):
         b = ModelBuilder()
