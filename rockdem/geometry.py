@@ -164,6 +164,10 @@ def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
         order = ids_new[np.argsort(ang)]
         # Drop vertices collinear with their neighbours (they are not face corners).
         order = _drop_collinear(verts, order, tol)
+        if len(order) < 3:  # a sliver thinner than the tolerance: its narrow faces collapse to lines
+            raise ValueError(
+                f"{name}: vertices are flat or degenerate (a face collapses to a line within {tol:.3g} m, 1e-7 of "
+                f"the block's size); give a block with a positive extent in all three directions")
         faces.append(order.astype(np.int64))
         normals.append(pn / np.linalg.norm(pn))
         offsets.append(pd)

@@ -266,6 +266,11 @@ def _velocity_table(
     return np.r_[tt, t[-1]], np.vstack([vv.reshape(-1, 3), vel[-1:]])
 
 
+def _is_number(value: Any) -> bool:
+    """A real number (NumPy scalars included), not a bool or a string."""
+    return not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
+
+
 def _has_ground_blocks(builder: ModelBuilder) -> bool:
     return bool(builder.block_names(driven=GROUND))
 
@@ -319,14 +324,16 @@ def apply_pushover(
         max_load_factor: final lambda [-] (held after the ramp); for a rigid block the capacity is B/H.
         direction: horizontal load direction (3,), normalised here.
     """
-    if not (math.isfinite(rate) and rate > 0.0):
+    if not (_is_number(rate) and math.isfinite(rate) and rate > 0.0):
         raise ValueError(f"pushover rate must be a positive load-factor rate [1/s], got {rate!r}")
-    if not (math.isfinite(max_load_factor) and max_load_factor > 0.0):
+    if not (_is_number(max_load_factor) and math.isfinite(max_load_factor) and max_load_factor > 0.0):
         raise ValueError(f"pushover max_load_factor must be positive, got {max_load_factor!r}")
     d = _horizontal_unit(direction, builder.gravity, "pushover direction")
     if builder.body_acceleration is not None:
         raise ValueError("the builder already has a body acceleration (another loading)")
-    g = float(np.linalg.norm(builder.gravity)) or STANDARD_GRAVITY
+    g = float(np.linalg.norm(builder.gravity))
+    if g == 0.0:  # a load factor is a fraction of the weight
+        raise ValueError("a load-controlled pushover applies lambda g: the model has no gravity; give it gravity")
     ramp = PushoverRamp(float(rate), float(max_load_factor), d, g)
     t_end = ramp.ramp_time
     builder.set_body_acceleration([0.0, t_end], [np.zeros(3), max_load_factor * g * d])
@@ -397,11 +404,11 @@ def apply_rod_pushover(
             with a critically damping dashpot beta = 2 / omega, omega = sqrt(kn rod_size span / m).
         name: rod block name.
     """
-    if not (isinstance(displacement, (int, float)) and math.isfinite(displacement) and displacement > 0):
+    if not (_is_number(displacement) and math.isfinite(displacement) and displacement > 0):
         raise ValueError(f"pushover displacement must be a positive distance [m], got {displacement!r}")
-    if not (isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity > 0):
+    if not (_is_number(velocity) and math.isfinite(velocity) and velocity > 0):
         raise ValueError(f"pushover velocity must be a positive speed [m/s] (slow: quasi-static), got {velocity!r}")
-    if not (isinstance(rod_size, (int, float)) and math.isfinite(rod_size) and rod_size > 0):
+    if not (_is_number(rod_size) and math.isfinite(rod_size) and rod_size > 0):
         raise ValueError(f"pushover rod_size must be a positive length [m], got {rod_size!r}")
     d = _horizontal_unit(direction, builder.gravity, "pushover direction")
     gn = float(np.linalg.norm(builder.gravity))
@@ -449,6 +456,9 @@ def apply_rod_pushover(
     motion = Motion(times, np.outer(speed * velocity, d))
     # one point across the rod: a line contact at the rod's centre height (a roller)
     builder.add_block(poly, group="pushover_rod", name=name, driven=motion, points=(1, 3))
+    if gn == 0.0:
+        warn_user("pushover rod in a model without gravity: its load factor is the rod force over the specimen's "
+                  f"mass times the standard {STANDARD_GRAVITY} m/s^2 (it has no weight)")
     return RodPushover(name, float(velocity), float(displacement), h, d, mass * (gn or STANDARD_GRAVITY))
 
 
@@ -535,6 +545,8 @@ def capacity_curve(
     if direction is None:
         direction = a.get("pushover_direction", (1.0, 0.0, 0.0))
     d = np.asarray(direction, dtype=float).reshape(3)
+    if not (np.all(np.isfinite(d)) and np.linalg.norm(d) > 0.0):
+        raise ValueError(f"capacity_curve: direction must be a non-zero finite 3-vector, got {direction!r}")
     d = d / np.linalg.norm(d)
     names = [str(n) for n in ds.monitor.values]
     if monitor not in names:

@@ -149,3 +149,12 @@ def test_bad_vertices_are_refused_with_a_clear_message(vertices, message):
 def test_box_sizes_must_be_positive(dims):
     with pytest.raises(ValueError, match="must be a positive length"):
         box(*dims)
+
+
+@pytest.mark.parametrize("height", [1e-7, 1e-9])
+def test_a_sliver_thinner_than_the_hull_tolerance_is_refused(height):
+    """A tetrahedron 1e-7 of its size thick: its narrow faces collapse to lines within the hull's
+    tolerance; it was accepted with two empty faces and finalize failed with an IndexError."""
+    with pytest.raises(ValueError, match="sliver: vertices are flat or degenerate"):
+        convex_hull([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, height]], name="sliver")
+    assert len(convex_hull([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1e-5]]).faces) == 4

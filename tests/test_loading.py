@@ -353,3 +353,19 @@ def test_pushover_measures_rocking_about_up_cross_the_load(direction):
     np.testing.assert_allclose(ds.attrs["rocking_axis"], np.cross((0.0, 0.0, 1.0), d), atol=1e-12)
     assert float(ds.block_eta.sel(block="block")) == pytest.approx(np.arctan(thin / 1.0), rel=1e-9)
     assert float(ds.rocking_angle.sel(block="block")[-1]) > 0.05  # overloaded: rocking (toppling) along d, positive
+
+
+def test_pushover_arguments_are_checked_and_numpy_numbers_accepted():
+    """A rate given as a string is refused naming it (a TypeError before), a NumPy displacement is
+    taken (it was refused as not positive), a load-controlled pushover without gravity is refused
+    (its load factor is a fraction of the weight: it silently used 9.81 m/s^2)."""
+    from rockdem.loading import apply_pushover, apply_rod_pushover
+
+    with pytest.raises(ValueError, match="pushover rate must be a positive"):
+        apply_pushover(_block_builder(0.2, 1.0, 0.5, points=2, kn=1e9, ground=True), rate="0.1", max_load_factor=0.3)
+    rod = apply_rod_pushover(_block_builder(0.2, 1.0, 0.5, points=2, kn=1e9, ground=True), displacement=np.float32(0.1),
+                             velocity=np.float64(0.01))
+    assert rod.displacement == pytest.approx(0.1)
+    b = ModelBuilder(gravity=(0.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="no gravity"):
+        apply_pushover(b, rate=0.1, max_load_factor=0.3)
