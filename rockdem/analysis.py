@@ -24,6 +24,7 @@ from typing import Any, Mapping
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from ._warn import warn_user
+from .materials import real_number
 
 __all__ = [
     "rocking_direction",
@@ -107,10 +108,9 @@ class Bouncing:
 
 def _scalar(value: Any, what: str, *, positive: bool = False) -> float:
     """``value`` as a finite float >= 0 (> 0 with ``positive``), or ValueError naming ``what``."""
-    ok = not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-    v = float(value) if ok else math.nan
-    if not (math.isfinite(v) and (v > 0 if positive else v >= 0)):
-        raise ValueError(f"{what} must be a finite number {'> 0' if positive else '>= 0'}, got {value!r}")
+    v = real_number(value, what)
+    if not (v > 0 if positive else v >= 0):
+        raise ValueError(f"{what} must be {'> 0' if positive else '>= 0'}, got {value!r}")
     return v
 
 
@@ -393,9 +393,7 @@ def bouncing(
         if base.shape != z.shape or not np.all(np.isfinite(base)):
             raise ValueError(f"bouncing: z_contact must be finite, of the shape of z {z.shape}, got {base.shape}")
     else:
-        if z_rest is not None and not (isinstance(z_rest, (int, float, np.integer, np.floating)) and math.isfinite(z_rest)):
-            raise ValueError(f"bouncing: z_rest must be a finite height [m], got {z_rest!r}")
-        base = np.full_like(z, z[0] if z_rest is None else float(z_rest))
+        base = np.full_like(z, z[0] if z_rest is None else real_number(z_rest, "bouncing: z_rest [m]"))
     d = z - base
     tol = 1e-5 if tol is None else _scalar(tol, "bouncing: tol [m]", positive=True)
     air = d > tol

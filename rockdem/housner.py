@@ -33,6 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
+from .materials import real_number
+
 __all__ = [
     "G",
     "HousnerBlock",
@@ -66,7 +68,7 @@ class HousnerBlock:
     def __post_init__(self) -> None:
         for name in ("b", "h", "g"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not (isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v) and v > 0):
+            if not real_number(v, f"HousnerBlock.{name}") > 0:
                 raise ValueError(f"HousnerBlock.{name} must be a positive finite number, got {v!r}")
             object.__setattr__(self, name, float(v))  # a NumPy scalar kept as a float
 
@@ -214,11 +216,9 @@ def rock(
         raise ValueError(f"dt_out must lie in (0, duration], got {dt_out!r}")
     if wall_side not in (-1, 1):
         raise ValueError(f"wall_side must be -1 or +1, got {wall_side!r}")
-    for name, v, unit in (("theta0", theta0, "rad"), ("omega0", omega0, "rad/s")):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
-            raise ValueError(f"{name} must be a finite number [{unit}], got {v!r}")
-    if not (isinstance(rest_amplitude, (int, float, np.integer, np.floating)) and math.isfinite(rest_amplitude)
-            and rest_amplitude > 0):
+    real_number(theta0, "theta0 [rad]")
+    real_number(omega0, "omega0 [rad/s]")
+    if not real_number(rest_amplitude, "rest_amplitude (a fraction of eta)") > 0:
         raise ValueError(f"rest_amplitude must be a positive fraction of eta, got {rest_amplitude!r}")
     th_over = eta if overturn_angle is None else float(overturn_angle)
     if not (eta <= th_over <= 0.5 * math.pi):

@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from ._warn import warn_user
 from .case import Table, loading
 from .geometry import box, mass_properties
+from .materials import real_number
 from .analysis import fallen_blocks
 from .model import GROUND, Damping, ModelBuilder, Motion
 from .records import STANDARD_GRAVITY, GroundMotion, read_record, record_path
@@ -266,11 +267,6 @@ def _velocity_table(
     return np.r_[tt, t[-1]], np.vstack([vv.reshape(-1, 3), vel[-1:]])
 
 
-def _is_number(value: Any) -> bool:
-    """A real number (NumPy scalars included), not a bool or a string."""
-    return not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-
-
 def _has_ground_blocks(builder: ModelBuilder) -> bool:
     return bool(builder.block_names(driven=GROUND))
 
@@ -324,9 +320,9 @@ def apply_pushover(
         max_load_factor: final lambda [-] (held after the ramp); for a rigid block the capacity is B/H.
         direction: horizontal load direction (3,), normalised here.
     """
-    if not (_is_number(rate) and math.isfinite(rate) and rate > 0.0):
+    if not real_number(rate, "pushover rate [1/s]") > 0.0:
         raise ValueError(f"pushover rate must be a positive load-factor rate [1/s], got {rate!r}")
-    if not (_is_number(max_load_factor) and math.isfinite(max_load_factor) and max_load_factor > 0.0):
+    if not real_number(max_load_factor, "pushover max_load_factor") > 0.0:
         raise ValueError(f"pushover max_load_factor must be positive, got {max_load_factor!r}")
     d = _horizontal_unit(direction, builder.gravity, "pushover direction")
     if builder.body_acceleration is not None:
@@ -404,11 +400,11 @@ def apply_rod_pushover(
             with a critically damping dashpot beta = 2 / omega, omega = sqrt(kn rod_size span / m).
         name: rod block name.
     """
-    if not (_is_number(displacement) and math.isfinite(displacement) and displacement > 0):
+    if not real_number(displacement, "pushover displacement [m]") > 0:
         raise ValueError(f"pushover displacement must be a positive distance [m], got {displacement!r}")
-    if not (_is_number(velocity) and math.isfinite(velocity) and velocity > 0):
+    if not real_number(velocity, "pushover velocity [m/s]") > 0:
         raise ValueError(f"pushover velocity must be a positive speed [m/s] (slow: quasi-static), got {velocity!r}")
-    if not (_is_number(rod_size) and math.isfinite(rod_size) and rod_size > 0):
+    if not real_number(rod_size, "pushover rod_size [m]") > 0:
         raise ValueError(f"pushover rod_size must be a positive length [m], got {rod_size!r}")
     d = _horizontal_unit(direction, builder.gravity, "pushover direction")
     gn = float(np.linalg.norm(builder.gravity))
