@@ -99,6 +99,11 @@ class EarthquakeInput:
         """Peak horizontal ground acceleration of the applied input [m/s^2]."""
         return float(np.max(np.linalg.norm(self.acceleration[:, :2], axis=1)))
 
+    @property
+    def pga_time(self) -> float:
+        """Simulation time [s] of the peak horizontal ground acceleration (the delay included)."""
+        return float(self.time[int(np.argmax(np.linalg.norm(self.acceleration[:, :2], axis=1)))])
+
 
 def resolve_record(name: str | Path) -> Path:
     """Find a record file: a path, a file name in ``$ROCKDEM_DATA`` or a shipped record's short or
@@ -796,6 +801,7 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,
         earthquake_pga_m_s2=info.pga,
+        earthquake_pga_time_s=info.pga_time,  # a run ending before it is warned about (run_cli.run_options)
         earthquake_duration_s=float(info.time[-1]),
     )
     ctx["series"]["ground_acceleration"] = (info.time, info.acceleration)

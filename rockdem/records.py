@@ -559,10 +559,13 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
         raise ValueError(f"{p}, line {linenos[j + 1]}: time step {steps[j]!r} s differs from the record's "
                          f"{dt_typ!r} s; rockdem needs a uniform dt (resample the file first)")
     dt = (t[-1] - t[0]) / (t.size - 1)
-    if dt == 1.0 and t[0] in (0.0, 1.0) and np.all(t == np.round(t)):
-        warn_user(f"{p}: column {time_column} counts the samples ({t[0]:g}, {t[1]:g}, {t[2] if t.size > 2 else t[1]:g}, ...) "
-                      "rather than giving times: dt = 1 s; if it is an index, give time_column (zero-based) for the "
-                      "column of times")
+    if dt >= 1.0 and (dt == 1.0 or t.size >= 10) and np.all(t == np.round(t)):
+        # A time step of whole seconds is no strong-motion record's: the column is a sample index or
+        # a time in milliseconds, and read as seconds it stretched the record 1000 times unnoticed.
+        raise ValueError(f"{p}: column {time_column} holds whole numbers ({t[0]:g}, {t[1]:g}, {t[2] if t.size > 2 else t[1]:g}, "
+                         f"...), a time step of {dt:g} s: sample numbers, or times in milliseconds? rockdem reads times "
+                         "in seconds: give time_column (zero-based) for the column of times in seconds, or convert the "
+                         "column to seconds")
     return GroundMotion.from_samples(acc, dt=dt, units=unit, name=p.stem, source=p,
                                      description=" | ".join(c for c in comments if c), start_time=float(t[0]))
 

@@ -18,6 +18,7 @@ import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
+from ._warn import warn_user
 from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, positive_int, stop_on_signals
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
 from .loading import EQUILIBRIUM_TOLERANCE, load_carried
@@ -45,7 +46,13 @@ def run_case(
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
     ``initial``, ``checkpoint``, ``checkpoint_every`` and ``threads`` are :func:`~rockdem.simulation.simulate`'s.
     """
-    ds = simulate(case.model, **run_options(case, duration), progress=progress, initial=initial, checkpoint=checkpoint,
+    options = run_options(case, duration)
+    peak = case.attrs.get("earthquake_pga_time_s")
+    if peak is not None and options["duration"] < float(peak):
+        warn_user(f"the run ends at {options['duration']:g} s ([run] duration or --duration), before the record's peak "
+                  f"ground acceleration (at {float(peak):.3g} s of the run): the specimen does not feel the strong "
+                  "motion; lengthen the run")
+    ds = simulate(case.model, **options, progress=progress, initial=initial, checkpoint=checkpoint,
                   checkpoint_every=checkpoint_every, threads=threads)
     with _deferred_signals(finishing=True):  # the frames are computed: a stop signal waits for the result
         ds.attrs.update(case.attrs)

@@ -274,8 +274,15 @@ def test_columns_chosen_in_a_wider_file(tmp_path: Path) -> None:
         with pytest.raises(ValueError, match="dt must be a positive time step"):
             read_record(path, units="g", dt=bad, acc_column=2)
     indexed = _write(tmp_path, "idx.csv", "idx,t,a\n0,0.00,0.1\n1,0.01,0.2\n2,0.02,0.3\n")
-    with pytest.warns(UserWarning, match="column 0 counts the samples .*give time_column"):
-        assert read_record(indexed, units="g", acc_column=2).dt == 1.0
+    with pytest.raises(ValueError, match="column 0 holds whole numbers .*milliseconds.*give time_column"):
+        read_record(indexed, units="g", acc_column=2)
+    millis = _write(tmp_path, "ms.txt", "".join(f"{k} {0.1 * np.sin(k / 50.0):.6f}\n" for k in range(200)))
+    with pytest.raises(ValueError, match="times in milliseconds"):  # 1 ms samples read as 1 s: 1000 times too slow
+        read_record(millis, units="g")
+    millis5 = _write(tmp_path, "ms5.txt", "".join(f"{5 * k} {0.1 * np.sin(k / 10.0):.6f}\n" for k in range(40)))
+    with pytest.raises(ValueError, match="a time step of 5 s"):
+        read_record(millis5, units="g")
+    assert read_record(_write(tmp_path, "ramp.txt", "0 0.1\n10 0.1\n"), units="g").dt == 10.0  # two samples: a ramp
     assert read_record(indexed, units="g", time_column=1, acc_column=2).dt == pytest.approx(0.01)
     case["loading"]["acc_column"] = "2"
     with pytest.raises(ValueError, match=r"\[loading\] acc_column must be an integer"):
@@ -513,7 +520,7 @@ def test_a_vertical_file_of_another_layout(tmp_path: Path) -> None:
         parse_case(case)
     case["loading"]["vertical_column"] = 2
     parse_case(case)
-    with pytest.raises(ValueError, match="omit dt; if that column counts samples, give time_column"):
+    with pytest.raises(ValueError, match="holds whole numbers .*give time_column"):
         read_record(_write(tmp_path, "i.csv", "0, 0.0, 0.1\n1, 0.01, 0.2\n2, 0.02, 0.3\n"), units="g", acc_column=2, dt=0.01)
 
 
