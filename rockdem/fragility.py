@@ -629,6 +629,12 @@ def _fragility_cli(args: argparse.Namespace) -> int:
         print(f"rockdem fragility: stopped; {Store(args.out).kept()}", file=sys.stderr)
         raise
     print(f"{ida_counts(df).line()} -> {Path(args.out) / 'table.csv'}, report.md")
+    if "error" in df:  # why runs errored (each distinct reason once; the table's "error" column has every row's)
+        reasons = df["error"].dropna().astype(str).value_counts()
+        for reason, n in reasons.head(3).items():
+            print(f"  {n} run(s) errored: {reason}", file=sys.stderr)
+        if len(reasons) > 3:
+            print(f"  ... {len(reasons) - 3} more reasons in the table's error column", file=sys.stderr)
     if frag is None:
         print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did; widen the PGA range)")
     else:

@@ -547,7 +547,7 @@ def capacity_curve(
         direction = a.get("pushover_direction", (1.0, 0.0, 0.0))
     d = np.asarray(direction, dtype=float).reshape(3)
     if not (np.all(np.isfinite(d)) and np.linalg.norm(d) > 0.0):
-        raise ValueError(f"capacity_curve: direction must be a non-zero finite 3-vector, got {direction!r}")
+        raise ValueError(f"capacity_curve: direction must be a non-zero finite 3-vector, got {_vector_text(direction)}")
     d = d / np.linalg.norm(d)
     names = [str(n) for n in ds.monitor.values]
     if monitor not in names:
@@ -669,6 +669,14 @@ def rocking_axis_of(direction: ArrayLike, gravity: ArrayLike, what: str = "direc
     return (float(axis[0]) + 0.0, float(axis[1]) + 0.0, float(axis[2]) + 0.0)  # + 0.0: no -0.0
 
 
+def _vector_text(v: object) -> str:
+    """A vector as a user wrote it ([0.0, 0.0, 1.0]), not as NumPy shows it (array([0., 0., 1.]))."""
+    try:
+        return str(np.asarray(v, dtype=float).tolist())
+    except (TypeError, ValueError):
+        return repr(v)
+
+
 def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: str) -> NDArray[np.float64]:
     d = np.asarray(direction, dtype=float).reshape(3)
     gn = float(np.linalg.norm(gravity))
@@ -677,7 +685,7 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
         d = d - up * (up @ d)
     n = float(np.linalg.norm(d))
     if not (math.isfinite(n) and n > 0):
-        raise ValueError(f"{what} must be a finite vector with a horizontal component, got {direction!r}")
+        raise ValueError(f"{what} must be a finite vector with a horizontal component, got {_vector_text(direction)}")
     return d / n
 
 

@@ -549,15 +549,16 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
     if np.any(steps <= 0.0):
         j = int(np.flatnonzero(steps <= 0.0)[0])
         raise ValueError(f"{p}, line {linenos[j + 1]}: time {float(t[j + 1]):g} does not increase "
-                         f"(previous {float(t[j]):g} on line {linenos[j]})")
+                         f"(previous {float(t[j]):g} on line {linenos[j]}); if column {time_column} is not the time, "
+                         "give time_column and acc_column (zero-based)")
     dt_typ = float(np.median(steps))
     # 1e-6 relative catches any missing or repeated sample; the eps term absorbs float noise in long times.
     tol = DT_RTOL * dt_typ + 16 * np.finfo(float).eps * float(np.max(np.abs(t)))
     off = np.flatnonzero(np.abs(steps - dt_typ) > tol)
     if off.size:
         j = int(off[0])
-        raise ValueError(f"{p}, line {linenos[j + 1]}: time step {steps[j]!r} s differs from the record's "
-                         f"{dt_typ!r} s; rockdem needs a uniform dt (resample the file first)")
+        raise ValueError(f"{p}, line {linenos[j + 1]}: time step {float(steps[j]):.6g} s differs from the record's "
+                         f"{dt_typ:.6g} s; rockdem needs a uniform dt (resample the file first)")
     dt = (t[-1] - t[0]) / (t.size - 1)
     if dt >= 1.0 and (dt == 1.0 or t.size >= 10) and np.all(t == np.round(t)):
         # A time step of whole seconds is no strong-motion record's: the column is a sample index or
@@ -620,6 +621,10 @@ def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
             raise ValueError(f"{p}: cannot tell the format from a first data line of {count} values; give the "
                              "columns: time_column and acc_column (zero-based; in a case file, keys of [loading], "
                              "e.g. time_column = 0, acc_column = 2), or call read_columns")
+    if any(re.search(r"\d,\d", line) and ";" in line for line in lines[:_HEADER_SCAN_LINES]):
+        raise ValueError(f"{p}: no numeric data line found; the file looks like a spreadsheet export with ';' "
+                         "between fields and decimal commas (1,5 for 1.5): save it with '.' decimals and ',', ';', "
+                         "tab or space between the fields")
     raise ValueError(f"{p}: no numeric data line found")
 
 

@@ -637,7 +637,8 @@ def _sunk(model: Model, state: Any, thickness: np.ndarray) -> tuple[str, str] | 
     return a, (
         f"block {a!r} sank {depth[k]:.3g} m into {b!r}, more than {SINK_FRACTION:.0%} of the thinner block: the joint "
         f"stiffness kn = {m.mat_kn[m.block_group[owner[k]], m.block_group[other[k]]]:.3g} Pa/m is far too low for the load "
-        "(kn = E / l with E in Pa, not MPa)"
+        f"(kn = E / l with E in Pa, not MPa), or the blocks far too heavy for it (block {a!r}: {m.block_mass[owner[k]]:.3g} kg; "
+        "a density is in kg/m^3, not N/m^3)"
     )
 
 

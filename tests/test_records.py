@@ -534,3 +534,18 @@ def test_a_window_reaching_beyond_the_record_is_warned_about() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         prepare_record(gm, window=(10.0, 40.0), baseline=False)  # inside: no warning
+
+
+def test_misread_files_say_how_to_read_them(tmp_path: Path) -> None:
+    """A spreadsheet export with ';' and decimal commas, swapped columns and a step that drifts are
+    refused with what to do, the numbers as a user writes them (no NumPy reprs)."""
+    euro = _write(tmp_path, "euro.csv", "t;a\n0,00;0,10\n0,01;0,20\n0,02;0,30\n")
+    with pytest.raises(ValueError, match="decimal commas"):
+        read_record(euro, units="g")
+    swapped = _write(tmp_path, "swapped.csv", "a,t\n0.3,0.00\n0.1,0.01\n0.2,0.02\n")
+    with pytest.raises(ValueError, match="does not increase .*give time_column and acc_column"):
+        read_record(swapped, units="g")
+    drift = _write(tmp_path, "drift.txt", "0.0 0.1\n0.01 0.2\n0.02 0.3\n0.035 0.1\n")
+    with pytest.raises(ValueError, match=r"time step 0\.015 s differs from the record's 0\.01 s") as err:
+        read_record(drift, units="g")
+    assert "np.float64" not in str(err.value)
