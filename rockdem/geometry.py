@@ -88,6 +88,10 @@ class MassProperties:
     inertia: NDArray[np.float64]
 
 
+MIN_THICKNESS = 1e-5
+"""A block thinner than this share of its size (across one of its faces) is refused by :func:`convex_hull`."""
+
+
 def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
     """Build a convex polyhedron from its vertices.
 
@@ -123,6 +127,14 @@ def convex_hull(vertices: ArrayLike, *, name: str = "block") -> Polyhedron:
             "extent in all three directions"
         ) from exc
     tol = 1e-7 * scale
+    # Width across each facet's plane: a block thinner than MIN_THICKNESS of its size (a slab 1e-9 m
+    # thick passed every other test) would need a timestep so small that its run never ends.
+    width = float(np.min(np.ptp(v @ hull.equations[:, :3].T, axis=0)))
+    if width < MIN_THICKNESS * scale:
+        raise ValueError(
+            f"{name}: the block is {width:.3g} m thin across one of its faces, {width / scale:.2g} of its size "
+            f"({scale:.3g} m); blocks thinner than {MIN_THICKNESS:g} of their size are refused (their timestep would be "
+            "vanishingly small): give a thicker block")
     # Group hull triangles by plane.
     planes: list[tuple[NDArray[np.float64], float, set[int]]] = []
     for simplex, eq in zip(hull.simplices, hull.equations):
