@@ -111,6 +111,23 @@ def resolve_record(name: str | Path) -> Path:
     return record_path(name)
 
 
+AT_REST = 1e-3
+"""A record whose velocity ends within this share of its peak velocity of rest is used without
+baseline correction (:func:`prepare_record`): a clean synthetic input, or a record already
+processed (the shipped PEER NGA ones end within 2e-4 of it)."""
+
+
+def _at_rest(gm: GroundMotion) -> bool:
+    """Whether record ``gm`` (and its vertical component) ends at rest (:data:`AT_REST`)."""
+    from .records import _integral  # noqa: PLC0415 - the records' own trapezoid integral
+
+    for acc in [gm.acceleration] + ([] if gm.vertical is None else [gm.vertical]):
+        v = _integral(acc, gm.dt)
+        if abs(v[-1]) > AT_REST * float(np.max(np.abs(v))):
+            return False
+    return True
+
+
 def prepare_record(
     motion: GroundMotion,
     *,
@@ -124,7 +141,9 @@ def prepare_record(
 ) -> GroundMotion:
     """Process a record for application: window, scale (or scale to ``pga`` [m/s^2]), direction,
     baseline correction (linear velocity trend removed, the ground brought to rest at the end:
-    :meth:`rockdem.records.GroundMotion.baseline_corrected`) and a free-vibration tail [s].
+    :meth:`rockdem.records.GroundMotion.baseline_corrected`; only for a record that does not end at
+    rest, :data:`AT_REST`: a clean pulse was distorted by it, 0.0039 g added throughout and its
+    ground displacement tripled) and a free-vibration tail [s].
 
     The windowed record restarts from rest at the window start. At least one zero-acceleration
     sample is appended so that the held end value of the input tables is "no acceleration".
@@ -152,7 +171,7 @@ def prepare_record(
     if not (math.isfinite(scale) and scale >= 0.0):
         raise ValueError(f"{gm.name}: scale must be a finite factor >= 0, got {scale!r}")
     gm = gm.scaled_to_pga(pga) if pga is not None else gm.scaled(scale)
-    if baseline:
+    if baseline and not _at_rest(gm):
         gm = gm.baseline_corrected(1)
     if not (math.isfinite(tail) and tail >= 0.0):
         raise ValueError(f"{gm.name}: tail must be >= 0 s, got {tail!r}")

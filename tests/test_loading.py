@@ -372,3 +372,22 @@ def test_pushover_arguments_are_checked_and_numpy_numbers_accepted():
     b = ModelBuilder(gravity=(0.0, 0.0, 0.0))
     with pytest.raises(ValueError, match="no gravity"):
         apply_pushover(b, rate=0.1, max_load_factor=0.3)
+
+
+def test_a_record_ending_at_rest_is_applied_as_it_is():
+    """A one-sine pulse (0.3 g, Tp = 0.5 s) followed by 3.5 s of zeros ends at rest: the default
+    baseline correction used to fit a line to its velocity bump and add 0.0039 g throughout, so the
+    applied PGA was 0.3039 g and the ground's final displacement 0.39 m instead of the pulse's
+    A Tp^2 / (2 pi) = 0.117 m. Such a record is now applied as it is; a record with an offset is
+    still corrected (brought to rest at its end)."""
+    from rockdem.loading import prepare_record
+    from rockdem.records import STANDARD_GRAVITY, GroundMotion
+
+    dt, tp, amp = 0.005, 0.5, 0.3 * STANDARD_GRAVITY
+    t = np.arange(0.0, 4.0 + dt / 2, dt)
+    acc = np.where(t <= tp, amp * np.sin(2 * np.pi * t / tp), 0.0)
+    gm = prepare_record(GroundMotion.from_samples(acc, dt=dt, units="m/s2", name="pulse"))
+    np.testing.assert_array_equal(gm.acceleration[: acc.size], acc)
+    assert gm.displacement()[-1] == pytest.approx(amp * tp**2 / (2 * np.pi), rel=1e-3)
+    offset = prepare_record(GroundMotion.from_samples(acc + 0.01, dt=dt, units="m/s2", name="offset"))
+    assert abs(offset.velocity()[-1]) < 1e-9 and not np.allclose(offset.acceleration[: t.size], acc + 0.01)
