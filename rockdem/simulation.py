@@ -468,7 +468,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         _warn_not_at_rest(model, state)
     state.dt[0] = state.dt_prev[0] = state.dt_min[0] = state.dt_coarse[0] = info.dt
     state.refinement[0], state.impact_window[0], state.impact_speed[0] = impact_windows(model, info, impact_refinement)
-    state.refine_until[0] = state.refined_time[0] = 0.0
+    state.refine_until[0] = state.refine_limit[0] = state.refined_time[0] = 0.0
     state.safety[0] = safety
     state.resolution[0] = resolution if info.rule == "bound" else 1.0
     state.dashpots[0] = dashpot_code(info.dashpots)

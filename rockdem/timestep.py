@@ -115,7 +115,8 @@ MAX_IMPACT_REFINEMENT = 100.0
 
 IMPACT_WINDOW_PERIODS = 1.0
 """An impact window opens this many periods 2 pi / omega_max of the stiffest contact before a
-predicted impact and closes twice as long after it (:data:`rockdem.kernels.step.IMPACT_AFTER`)."""
+predicted impact and closes twice as long after it (:data:`rockdem.kernels.step.IMPACT_AFTER`), or
+later, once the impact has ended (:data:`rockdem.kernels.step.IMPACT_TAIL`)."""
 
 IMPACT_OVERLAPS = 5.0
 """A touch is an impact (opens a window) when its dynamic overlap v / omega_max exceeds this many
@@ -128,8 +129,9 @@ def impact_windows(model: Model, info: TimestepInfo, refinement: float = IMPACT_
     The kernel (:func:`rockdem.kernels.step.advance`) divides the step by ``refinement`` from
     ``window`` before an open unbonded sub-contact is predicted to touch (its gap over its closing
     speed, when that speed exceeds ``impact speed``) until two windows after the touch
-    (``kernels.step.IMPACT_AFTER``), while the windows cover at most :data:`IMPACT_SHARE` of the
-    time so far. The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max: an
+    (``kernels.step.IMPACT_AFTER``), or later while a pressed sub-contact still moves faster than
+    the impact speed (``kernels.step.IMPACT_TAIL``), while the windows cover at most
+    :data:`IMPACT_SHARE` of the time so far. The impact speed is :data:`IMPACT_OVERLAPS` g / omega_max: an
     impact whose dynamic overlap v / omega_max exceeds 5 static overlaps g / omega_max^2 (any closing
     speed without gravity). Refinement 1, the rules "user" and "3dec" and explicit dashpots (kept as
     3DEC's scheme) have no windows.

@@ -195,16 +195,21 @@ def _supporting_edge(m: ModelArrays, sc: Scratch, blk: int, i: int, nx: float, n
 
 INCIDENT_KEEP = 0.1
 """The incident face of the last detection is kept while its deepest vertex (along the reference
-normal) is within this many tracking tolerances of the deepest vertex of the most opposed face: a
-block rocking on the edge between two of its faces (both reach the same depth) keeps the face
-carrying its sub-contacts (each switch re-represents a loaded contact), while a face landing
-flat takes over as soon as it reaches deeper, or as soon as all its corners come within the
-tolerance of its deepest one (it is about to land flat: its far corners must be tracked before
-they press). Without the second rule a brick pivoting down onto its bed face kept its end face
-(they share the pivot edge) until the bed face's far edge was 0.29 mm into the ground, and its
-sub-contacts switched on there with 15 J at once. (A hysteresis in angle instead, 0.05 in
-cosine, kept the rounded-edge facet of a toppling façade while its 0.8 m face swung 0.12 m into
-the ground.)"""
+normal) is within this many tracking tolerances of the deepest vertex of the most opposed face,
+and every corner of the most opposed face within the tracking tolerance of that face's deepest is
+a corner of the kept face too (:func:`_incident_face`): a block rocking on the edge between two of
+its faces (both reach the same depth) keeps the face carrying its sub-contacts (each switch
+re-represents a loaded contact), while a face landing flat takes over as soon as it reaches deeper,
+or as soon as a corner the kept face lacks comes within the tolerance (it is about to press: it
+must be tracked before it does, and only the incident face carries sub-contacts). Without that
+rule a brick pivoting down onto its bed face kept its end face (they share the pivot edge) until
+the bed face's far edge was 0.29 mm into the ground, and its sub-contacts switched on there with
+15 J at once; until 2026-11-30 the rule asked only for *all* the corners of the most opposed face
+within the tolerance, and a wedge pivoting on a vertex of a face standing upright kept that face
+while the next corner of its inclined face came down onto the ground, untracked, 0.49 mm deep in
+22 steps, whose spring then switched on with 25 J (12 % of the run's energy scale). (A hysteresis
+in angle instead, 0.05 in cosine, kept the rounded-edge facet of a toppling façade while its
+0.8 m face swung 0.12 m into the ground.)"""
 
 
 @njit(cache=True, _nrt=False)
@@ -253,7 +258,7 @@ def _incident_face(
 ) -> int:
     """Face of ``blk`` most opposed to the world direction n, or ``previous`` (a face of blk, or
     -1) while it reaches as deep along -n as that face, within INCIDENT_KEEP tolerances ``tol``,
-    and that face's corners are not all within ``tol`` of its deepest one."""
+    and has every corner of that face within ``tol`` of its deepest one."""
     r = sc.rotation[blk]
     lowest = np.inf
     out = -1
@@ -262,10 +267,27 @@ def _incident_face(
         if c < lowest:
             lowest, out = c, g
     if previous >= 0 and previous != out:
-        low, high = _face_span(m, sc, out, nx, ny, nz)
-        if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and high - low >= tol:
+        low, _ = _face_span(m, sc, out, nx, ny, nz)
+        if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and _near_corners_shared(m, sc, out, previous, nx, ny, nz, low + tol):
             return previous
     return out
+
+
+@njit(cache=True, _nrt=False)
+def _near_corners_shared(
+    m: ModelArrays, sc: Scratch, f: int, g: int, nx: float, ny: float, nz: float, level: float
+) -> bool:
+    """Whether every corner of face f below ``level`` along the world direction n [m] (world
+    vertices current) is a corner of face g."""
+    for c in range(m.face_corner_start[f], m.face_corner_start[f + 1]):
+        v = m.face_corner[c]
+        if nx * sc.world_vertex[v, 0] + ny * sc.world_vertex[v, 1] + nz * sc.world_vertex[v, 2] < level:
+            shared = False
+            for d in range(m.face_corner_start[g], m.face_corner_start[g + 1]):
+                shared = shared or m.face_corner[d] == v
+            if not shared:
+                return False
+    return True
 
 
 @njit(cache=True, _nrt=False)

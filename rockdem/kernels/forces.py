@@ -528,6 +528,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
     e_bond = 0.0
     nrel = 0
     touch = np.inf
+    impacting = False
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] == PAIR_EDGE:
             continue
@@ -545,6 +546,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
             e_fric += sc.side_friction[i, side]
             e_bond += sc.side_bond[i, side]
             touch = min(touch, sc.side_touch[i, side])
+            impacting = impacting or sc.side_impacting[i, side]
             f = sc.side_force[i, side]
             q = sc.side_moment[i, side]
             _apply_resultant(s.position, m.block_free, sc.force, sc.torque, sc.reaction, o, t, f[0], f[1], f[2], q[0], q[1], q[2])
@@ -561,6 +563,7 @@ def _gather(m: ModelArrays, s: State, sc: Scratch) -> tuple[float, int, float, f
                     sc.pending_pair[nrel] = i
                     nrel += 1
     sc.touch_time[0] = touch
+    sc.impacting[0] = impacting
     return elastic, active, e_fric, e_bond, nrel
 
 
@@ -624,7 +627,11 @@ def _law_range(
     released = 0
     failed = 0
     touch = np.inf
+    impacting = False
     impact_speed = s.impact_speed[0]
+    # The dynamic overlap of an impact at the impact speed, v / omega_max (the window is one
+    # period 2 pi / omega_max of the stiffest contact): five static overlaps g / omega_max^2.
+    impact_depth = impact_speed * s.impact_window[0] / (2.0 * math.pi) if s.impact_window[0] > 0.0 else np.inf
     sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = 0.0
     fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
     # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
@@ -843,6 +850,11 @@ def _law_range(
         if gone:
             continue
         elastic += 0.5 * (fn * un + ksa * (us0 * us0 + us1 * us1 + us2 * us2))  # the springs' energies (shear after any slip)
+        # A pressed unbonded sub-contact moving at an impact speed, deeper than an impact's
+        # dynamic overlap at that speed (impact_depth): an impact goes on (an open impact window
+        # lasts until it ends, kernels.step.advance). Blocks resting, rolling or sliding on one
+        # another press far less deep at such speeds.
+        impacting = impacting or (abs(vn) > impact_speed and un > impact_depth and not bonded)
         if blending:
             u_side += 0.5 * kn * full_area * stiff * un * un
         active += 1
@@ -898,6 +910,7 @@ def _law_range(
     sc.side_released[i, side] = released
     sc.side_failed[i, side] = failed
     sc.side_touch[i, side] = touch
+    sc.side_impacting[i, side] = impacting
     return u_side
 
 

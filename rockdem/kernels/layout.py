@@ -161,6 +161,7 @@ class State(NamedTuple):
     impact_window: np.ndarray  # (1,) [s] a window opens this long before a predicted impact (0: never; step.IMPACT_AFTER)
     impact_speed: np.ndarray  # (1,) [m/s] closing speed above which an unbonded sub-contact's touch is an impact
     refine_until: np.ndarray  # (1,) [s] end of the present impact window (<= time: none)
+    refine_limit: np.ndarray  # (1,) [s] latest end of the present window (kernels.step.IMPACT_LONGEST after its touch)
     refined_time: np.ndarray  # (1,) [s] simulated time spent in impact windows so far
     dashpots: np.ndarray  # (1,) int64 DASHPOTS_IMPLICIT or DASHPOTS_EXPLICIT
     dashpot_sweeps: np.ndarray  # (1,) int64 Jacobi sweeps of the implicit dashpots of coupled free blocks so far
@@ -274,6 +275,7 @@ class Scratch(NamedTuple):
     side_released: np.ndarray  # (P, 2) int64 sub-contacts that opened during the last step
     side_failed: np.ndarray  # (P, 2) int64 bonds that failed at this step
     side_touch: np.ndarray  # (P, 2) [s] soonest impact predicted on the side (an open sub-contact's gap / closing speed), inf none
+    side_impacting: np.ndarray  # (P, 2) bool a pressed unbonded sub-contact of the side moves at an impact speed (State.impact_speed)
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
     blend_point_owner: np.ndarray  # (P, 3) [m] ... at this point (minus it on the target's block)
     blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block
@@ -298,6 +300,7 @@ class Scratch(NamedTuple):
     cand_face: np.ndarray  # (C,) int64 target face
     cand_slot: np.ndarray  # (C,) int64 slot given to the candidate, -1 none
     touch_time: np.ndarray  # (1,) [s] soonest impact predicted at the last force pass (side_touch's least), inf none
+    impacting: np.ndarray  # (1,) bool any side_impacting at the last force pass: an impact is going on
     prev_pair_count: np.ndarray  # (1,) int64 previous detection's pairs (for edge-contact history)
     prev_pair_a: np.ndarray  # (P,) int64
     prev_pair_b: np.ndarray  # (P,) int64
