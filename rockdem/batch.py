@@ -270,6 +270,27 @@ def _start(data: Mapping[str, Any], case: Case) -> Any:
     return start.copy()
 
 
+_SETTLED: OrderedDict[str, Any] = OrderedDict()
+
+
+def _settled(data: Mapping[str, Any], case: Case) -> Any:
+    """The settled start of a case with ``[run] settle`` (:func:`rockdem.run_cli.settled_start`, a
+    copy), kept per specimen and timestep options: the settling does not depend on the loading."""
+    from .run_cli import settled_start
+
+    r = case.run
+    key = json.dumps([template_key(data), r.settle, r.timestep_rule, r.safety, r.resolution, r.dt], sort_keys=True, default=str)
+    with _LOCK:
+        ck = _SETTLED.get(key)
+    if ck is None:
+        ck = settled_start(case)
+        with _LOCK:
+            _SETTLED[key] = ck
+            while len(_SETTLED) > TEMPLATE_CACHE:
+                _SETTLED.popitem(last=False)
+    return ck.reset_clock()
+
+
 def batch_row(spec: Any) -> dict[str, Any]:
     """The summary row of one spec by the batch path (raises as :func:`rockdem.studies.run_spec`)."""
     from .run_cli import run_options
@@ -282,7 +303,10 @@ def batch_row(spec: Any) -> dict[str, Any]:
         warnings.simplefilter("ignore")
         # One thread per run: a study spreads its runs over the cores (and Numba's default
         # workqueue threads must not be started from two Dask worker threads at once).
-        out = run_model(case.model, **run_options(case), progress=False, start=_start(data, case), threads=1)
+        if case.run.settle > 0.0:  # from the blocks settled under gravity ([run] settle), once per specimen
+            out = run_model(case.model, **run_options(case), progress=False, initial=_settled(data, case), threads=1)
+        else:
+            out = run_model(case.model, **run_options(case), progress=False, start=_start(data, case), threads=1)
     row = summary_row(spec, data, frames_from_run(case, out))
     row["wall_s"] = time.perf_counter() - t0
     row["cpu_s"] = time.process_time() - c0

@@ -239,6 +239,11 @@ class RunOptions:
     contact_tolerance: float | None = None
     contact_interval: float | None = None
     stop: str = "off"
+    settle: float = 0.0
+
+
+SETTLE_LONGEST = 2.0
+"""[s] the longest settling of ``[run] settle = true`` (it ends earlier once the blocks are at rest)."""
 
 
 @dataclass(frozen=True, repr=False)
@@ -532,9 +537,20 @@ def _run_options(top: Table) -> RunOptions:
         contact_tolerance=run_t.optional_number("contact_tolerance", positive=True),
         contact_interval=run_t.optional_number("contact_interval", positive=True),
         stop=run_t.string("stop", "off", choices=STOP_MODES),
+        settle=_settle_time(run_t),
     )
     run_t.finish()
     return run
+
+
+def _settle_time(run_t: Table) -> float:
+    """``[run] settle``: false (0), true (:data:`SETTLE_LONGEST`) or the longest settling [s]."""
+    v = run_t.raw("settle", False)
+    if isinstance(v, bool):
+        return SETTLE_LONGEST if v else 0.0
+    if not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+        raise ValueError(f"[{run_t.where}] settle must be true, false or the longest settling time [s], got {v!r}")
+    return float(v)
 
 
 def _specimen(top: Table) -> tuple[ModelBuilder, dict[str, Monitor]]:

@@ -1046,7 +1046,7 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
             "decays; a block held by friction near its limit (on a slope, in a wedge) creeps at every cycle (1 mm/s "
             "on a 20 deg slope at a 30 deg friction angle) and sliding outruns Coulomb's law by up to 20 %; a small "
             f"SP damping removes both, e.g. damping.beta = {UNDAMPED_HINT * critical:.2g} s ({UNDAMPED_HINT:.0%} of "
-            "critical on the slowest impact)")
+            "critical on the slowest impact), or start from the blocks settled (a case's [run] settle = true)")
         return
     if not beta > 0.0:
         return
@@ -1055,7 +1055,8 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
             f"damping.beta = {beta:g} s is {beta / critical:.3g} times the critical value 2 / omega = {critical:.3g} s "
             f"of the slowest impact (block {model.block_names[int(free[k])]!r} on its smallest face, omega = "
             f"{float(omega[k]):.4g} rad/s): every impact is over-damped, blocks settle into their joints over about "
-            f"beta seconds; DeJong's beta (paper §2.2) is the critical one (damping.beta = \"critical\")")
+            f"beta seconds; DeJong's rule (paper §2.2, rockdem advise) gives a beta of the order of the critical one, "
+            f"damping.beta = \"critical\" each joint's own")
 
 
 def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointMaterial], size: float) -> None:

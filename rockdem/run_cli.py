@@ -4,19 +4,22 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import copy
 import math
 import os
 import shlex
 import signal
 import sys
+import tempfile
 import time
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import xarray as xr
 
-from .checkpoint import Checkpoint, load_checkpoint
+from .checkpoint import Checkpoint, load_checkpoint, structure_hash
 from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
 from ._warn import warn_user
 from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, positive_int, stop_on_signals
@@ -28,6 +31,40 @@ from .simulation import LIFT_1MM, REST_SHARE, _deferred_signals, simulate
 from .stopping import STOP_MODES
 
 __all__ = ["run_case", "run_options", "register_cli", "summary_lines"]
+
+
+SETTLE_LOCAL_DAMPING = 0.8
+"""Local damping of the settling run of ``[run] settle`` (Cundall's quasi-static value)."""
+
+
+def settled_start(case: Case) -> Checkpoint:
+    """The start of a case with ``[run] settle``: its model settled under gravity alone (the same
+    blocks and joints, no loading, local damping :data:`SETTLE_LOCAL_DAMPING`) until its blocks
+    are at rest or for ``case.run.settle`` seconds at most, its clock reset (docs/checkpoints.md,
+    "Settle once"). Gravity loads the joints' springs from zero at t = 0: without settling, they
+    ring about their static overlaps between no force and twice the weight, for ever undamped and
+    for about 2 / alpha seconds with mass-proportional damping alone."""
+    data = copy.deepcopy(case.data)
+    data["loading"] = {"type": "gravity"}
+    data["damping"] = {"local": SETTLE_LOCAL_DAMPING}
+    keep = ("dt", "timestep_rule", "safety", "resolution", "contact_tolerance", "contact_interval")
+    data["run"] = {**{k: v for k, v in data.get("run", {}).items() if k in keep}, "duration": case.run.settle}
+    data.pop("output", None)
+    try:
+        settle = parse_case(data)
+    except ValueError as exc:
+        raise ValueError(f"[run] settle: the case without its loading cannot be built ({exc})") from None
+    if structure_hash(settle.model) != structure_hash(case.model):
+        raise ValueError(f"[run] settle: the {case.data.get('loading', {}).get('type', 'gravity')} loading changes the "
+                         "blocks or their starting poses (a free-rocking release tilts them, a rod pushover adds its rod), "
+                         "so the case cannot start from its blocks settled without it; leave settle out")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "settled.npz"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # the settling run's own damping and stop notes
+            simulate(settle.model, case.run.settle, record_interval=min(0.01, case.run.settle / 5.0), stop="rest",
+                     checkpoint=path, progress=False)
+        return load_checkpoint(path).reset_clock()
 
 
 def run_case(
@@ -46,6 +83,8 @@ def run_case(
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
     ``initial``, ``checkpoint``, ``checkpoint_every`` and ``threads`` are :func:`~rockdem.simulation.simulate`'s.
     """
+    if case.run.settle > 0.0 and initial is None:
+        initial = settled_start(case)
     options = run_options(case, duration)
     peak = case.attrs.get("earthquake_pga_time_s")
     if peak is not None and options["duration"] < float(peak):

@@ -246,7 +246,7 @@ def initial_state(model: Model, *, check_overlap: bool = True) -> tuple[State, S
     if check_overlap and depth > START_OVERLAP_SHARE * m.touch_tol:
         a, b = (model.block_names[int(v)] for v in sc.min_pair)
         if depth > m.touch_tol:
-            raise ValueError(f"blocks {a!r} and {b!r} overlap by {depth:.4g} m at the start (tolerance {m.touch_tol:.3g} m); "
+            raise ValueError(f"blocks {a!r} and {b!r} overlap by {depth:.4g} m at the start (more than the touching tolerance, {m.touch_tol:.3g} m); "
                              "move them apart so that they at most touch")
         warn_user(
             f"blocks {a!r} and {b!r} overlap by {depth:.3g} m at the start: their joint springs start compressed by that "

@@ -27,6 +27,7 @@ def _specs(base, tmp_path):
     eq = {"run.record_interval": 0.01, "run.stop": "decided"}
     specs = [RunSpec.make(base, eq, duration=5.0, record=r, pga_g=p) for r in ("elcentro-peknold", "elcentro-rsn6") for p in (0.1, 0.3, 0.7)]
     specs.append(RunSpec.make(base, {**eq, "loading.units": "g"}, duration=2.0, record=str(bad), pga_g=0.3))  # an error row
+    specs.append(RunSpec.make(base, {**eq, "run.settle": True}, duration=3.0, record="elcentro-rsn6", pga_g=0.3))  # from settled blocks
     specs += [RunSpec.make(base, {**SMALL, "damping.beta": b}, duration=1.5, history=True, history_interval=0.02) for b in (0.001, 0.003)]
     specs += [RunSpec.make(base, {**SMALL, "run.stop": "rest", "damping.beta": 0.0, "damping.alpha": a}, duration=3.0, history=True)
               for a in (4.0, 8.0)]
