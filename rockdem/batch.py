@@ -283,7 +283,7 @@ def _settled(data: Mapping[str, Any], case: Case) -> Any:
     with _LOCK:
         ck = _SETTLED.get(key)
     if ck is None:
-        ck = settled_start(case)
+        ck, _ = settled_start(case)
         with _LOCK:
             _SETTLED[key] = ck
             while len(_SETTLED) > TEMPLATE_CACHE:

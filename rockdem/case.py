@@ -245,6 +245,12 @@ class RunOptions:
 SETTLE_LONGEST = 2.0
 """[s] the longest settling of ``[run] settle = true`` (it ends earlier once the blocks are at rest)."""
 
+SETTLE_SHORTEST = 1.0
+"""[s] the shortest ``[run] settle`` accepted: rest is judged over 0.5 s of stillness (stopping.REST_WINDOW)."""
+
+SETTLE_LONGEST_ACCEPTED = 60.0
+"""[s] the longest ``[run] settle`` accepted (blocks that do not settle in a minute do not stand)."""
+
 
 @dataclass(frozen=True, repr=False)
 class Case:
@@ -550,6 +556,9 @@ def _settle_time(run_t: Table) -> float:
         return SETTLE_LONGEST if v else 0.0
     if not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
         raise ValueError(f"[{run_t.where}] settle must be true, false or the longest settling time [s], got {v!r}")
+    if v > 0 and not SETTLE_SHORTEST <= v <= SETTLE_LONGEST_ACCEPTED:
+        raise ValueError(f"[{run_t.where}] settle = {v!r} s: give from {SETTLE_SHORTEST:g} s (rest is judged over "
+                         "0.5 s of stillness) to {SETTLE_LONGEST_ACCEPTED:g} s, or true ({SETTLE_LONGEST:g} s at most)")
     return float(v)
 
 

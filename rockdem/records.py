@@ -110,7 +110,10 @@ def _parse_units(units: str | AccelerationUnit, where: str = "units") -> Acceler
 _UNSIGNED = r"(?:\d+\.?\d*|\.\d+)(?:[EeDd][+-]?\d+)?"
 _NUMBER_RE = re.compile(rf"[+-]?{_UNSIGNED}")
 _TOKEN_RE = re.compile(rf"[+-]?{_UNSIGNED}(?:[+-]{_UNSIGNED})*")
-_SPLIT_RE = re.compile(r"[\s,]+")
+MAX_PLAUSIBLE_DT = 0.1
+"""[s] a time/acceleration file with a larger time step is warned about (times in milliseconds?)."""
+
+_SPLIT_RE = re.compile(r"[\s,;]+")
 
 
 def _parse_numbers(text: str, *, path: Path, lineno: int, delimiter: str | None = None) -> list[float]:
@@ -567,6 +570,9 @@ def read_columns(path: str | os.PathLike[str], *, units: str | AccelerationUnit,
                          f"...), a time step of {dt:g} s: sample numbers, or times in milliseconds? rockdem reads times "
                          "in seconds: give time_column (zero-based) for the column of times in seconds, or convert the "
                          "column to seconds")
+    if dt > MAX_PLAUSIBLE_DT:
+        warn_user(f"{p}: a time step of {dt:g} s; strong-motion records are sampled every 0.005 to 0.02 s: if column "
+                  f"{time_column} is in milliseconds, convert it to seconds")
     return GroundMotion.from_samples(acc, dt=dt, units=unit, name=p.stem, source=p,
                                      description=" | ".join(c for c in comments if c), start_time=float(t[0]))
 
@@ -607,6 +613,10 @@ def read_single_column(path: str | os.PathLike[str], *, dt: float, units: str | 
 def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
     if p.suffix.lower() == ".at2":
         return RecordFormat.AT2
+    if any(re.search(r"\d,\d", line) and re.search(r"[;\t]", line) for line in lines[:_HEADER_SCAN_LINES]):
+        raise ValueError(f"{p}: the file looks like a spreadsheet export with decimal commas (1,5 for 1.5) and ';' or "
+                         "tabs between the fields: save it with '.' decimals (any of ',', ';', tab or space between "
+                         "the fields then reads)")
     head = lines[:_HEADER_SCAN_LINES]
     if any((_NPTS_RE.search(s) and _DT_RE.search(s)) or _OLD_NPTS_DT_RE.search(s) for s in head):
         return RecordFormat.AT2
@@ -621,10 +631,6 @@ def _sniff_format(p: Path, lines: list[str]) -> RecordFormat:
             raise ValueError(f"{p}: cannot tell the format from a first data line of {count} values; give the "
                              "columns: time_column and acc_column (zero-based; in a case file, keys of [loading], "
                              "e.g. time_column = 0, acc_column = 2), or call read_columns")
-    if any(re.search(r"\d,\d", line) and ";" in line for line in lines[:_HEADER_SCAN_LINES]):
-        raise ValueError(f"{p}: no numeric data line found; the file looks like a spreadsheet export with ';' "
-                         "between fields and decimal commas (1,5 for 1.5): save it with '.' decimals and ',', ';', "
-                         "tab or space between the fields")
     raise ValueError(f"{p}: no numeric data line found")
 
 

@@ -20,7 +20,7 @@ import numpy as np
 import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint, structure_hash
-from .case import Case, apply_overrides, example_case, example_names, load_case, parse_case
+from .case import SETTLE_LONGEST, Case, apply_overrides, example_case, example_names, load_case, parse_case
 from ._warn import warn_user
 from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, positive_int, stop_on_signals
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
@@ -37,11 +37,11 @@ SETTLE_LOCAL_DAMPING = 0.8
 """Local damping of the settling run of ``[run] settle`` (Cundall's quasi-static value)."""
 
 
-def settled_start(case: Case) -> Checkpoint:
+def settled_start(case: Case) -> tuple[Checkpoint, float]:
     """The start of a case with ``[run] settle``: its model settled under gravity alone (the same
     blocks and joints, no loading, local damping :data:`SETTLE_LOCAL_DAMPING`) until its blocks
     are at rest or for ``case.run.settle`` seconds at most, its clock reset (docs/checkpoints.md,
-    "Settle once"). Gravity loads the joints' springs from zero at t = 0: without settling, they
+    "Settle once"), and the settling's length [s]. Raises ValueError where they did not come to rest. Gravity loads the joints' springs from zero at t = 0: without settling, they
     ring about their static overlaps between no force and twice the weight, for ever undamped and
     for about 2 / alpha seconds with mass-proportional damping alone."""
     data = copy.deepcopy(case.data)
@@ -62,9 +62,15 @@ def settled_start(case: Case) -> Checkpoint:
         path = Path(tmp) / "settled.npz"
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # the settling run's own damping and stop notes
-            simulate(settle.model, case.run.settle, record_interval=min(0.01, case.run.settle / 5.0), stop="rest",
-                     checkpoint=path, progress=False)
-        return load_checkpoint(path).reset_clock()
+            ds = simulate(settle.model, case.run.settle, record_interval=0.01, stop="rest", checkpoint=path, progress=False)
+        if ds.attrs.get("stop_reason") != "rest":
+            v = float(np.max(np.linalg.norm(ds.block_velocity.values[-1], axis=1)))
+            raise ValueError(
+                f"[run] settle: the blocks did not come to rest within {case.run.settle:g} s under gravity alone (the fastest "
+                f"moves at {v:.3g} m/s at the end): give a longer settle (true: up to {SETTLE_LONGEST:g} s), or the specimen "
+                "does not stand under its own weight (it tips or slides; run it without settle to see it)")
+        ck = load_checkpoint(path)
+        return ck.reset_clock(), float(ck.time)
 
 
 def run_case(
@@ -83,8 +89,9 @@ def run_case(
     (``case.series``, e.g. ``ground_acceleration``) become variables sampled at the recorded times.
     ``initial``, ``checkpoint``, ``checkpoint_every`` and ``threads`` are :func:`~rockdem.simulation.simulate`'s.
     """
-    if case.run.settle > 0.0 and initial is None:
-        initial = settled_start(case)
+    settled = None
+    if case.run.settle > 0.0 and initial is None:  # (a run continued from its checkpoint was settled when it began)
+        initial, settled = settled_start(case)
     options = run_options(case, duration)
     peak = case.attrs.get("earthquake_pga_time_s")
     if peak is not None and options["duration"] < float(peak):
@@ -95,6 +102,8 @@ def run_case(
                   checkpoint_every=checkpoint_every, threads=threads)
     with _deferred_signals(finishing=True):  # the frames are computed: a stop signal waits for the result
         ds.attrs.update(case.attrs)
+        if settled is not None:
+            ds.attrs["settled_s"] = settled  # the blocks were settled under gravity alone this long first ([run] settle)
         t = ds.time.values
         for name, (ts, values) in case.series.items():
             v = np.column_stack([np.interp(t, ts, values[:, i], left=0.0, right=0.0) for i in range(values.shape[1])])

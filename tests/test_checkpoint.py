@@ -315,8 +315,19 @@ def test_run_settle_starts_a_case_with_its_joints_carrying_the_weight(tmp_path):
     assert base(plain).max() > 1.5 * weight and slip(plain) > 2e-4  # the ring: up to twice the weight; it slipped
     np.testing.assert_allclose(base(settled)[:50], weight, rtol=0.01)  # at rest from t = 0
     assert slip(settled) < 5e-5
+    assert settled.attrs["settled_s"] < 1.0 and "settled_s" not in plain.attrs  # at rest in 0.5 s of stillness
     with pytest.raises(ValueError, match="settle must be true, false or the longest settling time"):
         parse_case(_pulse_case(tmp_path, settle="yes"))
+    for short_or_long in (0.001, 1e9):
+        with pytest.raises(ValueError, match=r"settle = .* s: give from 1 s"):
+            parse_case(_pulse_case(tmp_path, settle=short_or_long))
+    # A façade on a 10 deg slope, beyond its 7.8 deg limit, falls under its own weight: it cannot start settled.
+    facade = {**_pulse_case(tmp_path, settle=True), "damping": {"beta": 0.00025}}
+    facade["specimen"] = {"type": "facade", "width": 0.11, "height": 0.8, "length": 1.5, "density": 1750.0,
+                          "gap": 0.004, "slope_deg": 10.0, "youngs_modulus": 1.8e9, "friction_angle_deg": 30.96}
+    with pytest.raises(ValueError, match=r"settle: the blocks did not come to rest within 2 s .*does not stand"):
+        run_case(parse_case(facade), progress=False)
+
     free = {**example_case("free-rocking"), "run": {"duration": 0.1, "settle": True}}
     with pytest.raises(ValueError, match=r"\[run\] settle: the free-rocking loading changes the blocks"):
         run_case(parse_case(free), progress=False)

@@ -173,3 +173,18 @@ def test_a_slab_thinner_than_a_hundred_thousandth_of_its_size_is_refused():
     plate = convex_hull([[0, 0, 0], [0.2, 0, 0], [0, 0.2, 0], [0.2, 0.2, 0], [0, 0, 0.002], [0.2, 0, 0.002],
                          [0, 0.2, 0.002], [0.2, 0.2, 0.002]], name="plate")
     assert len(plate.faces) == 6
+
+
+@pytest.mark.parametrize("bump", [1e-8, 1e-6, 1e-5])
+def test_a_vertex_raised_a_hair_above_a_face_leaves_the_mass_right(bump):
+    """A 1 m cube with a vertex ``bump`` above the middle of its top face (a mesh export's round-off):
+    merged into the top face within the tolerance, that vertex was sorted into the face's outline
+    by angle, cut it, and the cube weighed 962.96 kg instead of 1000 (a new user's review). The
+    outline is the convex hull of the face's points: the cube's mass, centroid and six faces."""
+    from rockdem.geometry import mass_properties
+
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (0.0, 1.0)])
+    poly = convex_hull(np.vstack([corners, [[0.0, 0.0, 1.0 + bump]]]), name="bumped")
+    mp = mass_properties(poly, 1000.0)
+    assert len(poly.faces) == 6 and all(len(f) == 4 for f in poly.faces)
+    assert mp.mass == pytest.approx(1000.0, rel=1e-5) and mp.centroid[2] == pytest.approx(0.5, abs=1e-5)

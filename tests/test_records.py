@@ -549,3 +549,11 @@ def test_misread_files_say_how_to_read_them(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"time step 0\.015 s differs from the record's 0\.01 s") as err:
         read_record(drift, units="g")
     assert "np.float64" not in str(err.value)
+    tabs = _write(tmp_path, "tabs.txt", "0,00\t0,10\n0,01\t0,20\n0,02\t0,30\n")
+    with pytest.raises(ValueError, match="decimal commas"):
+        read_record(tabs, units="g")
+    dots = _write(tmp_path, "dots.csv", "t;a\n0.00;0.10\n0.01;0.20\n0.02;0.30\n")  # what the message advises
+    assert read_record(dots, units="g").dt == pytest.approx(0.01)
+    half = _write(tmp_path, "half_ms.txt", "".join(f"{2.5 * k} 0.1\n" for k in range(20)))  # 2.5 ms steps, in ms
+    with pytest.warns(UserWarning, match="a time step of 2.5 s.*milliseconds"):
+        read_record(half, units="g")
