@@ -258,7 +258,7 @@ def _incident_face(
 ) -> int:
     """Face of ``blk`` most opposed to the world direction n, or ``previous`` (a face of blk, or
     -1) while it reaches as deep along -n as that face, within INCIDENT_KEEP tolerances ``tol``,
-    and has every corner of that face within ``tol`` of its deepest one."""
+    and has every corner of that face that lies within ``tol`` of that face's deepest one."""
     r = sc.rotation[blk]
     lowest = np.inf
     out = -1

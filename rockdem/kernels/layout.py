@@ -275,7 +275,7 @@ class Scratch(NamedTuple):
     side_released: np.ndarray  # (P, 2) int64 sub-contacts that opened during the last step
     side_failed: np.ndarray  # (P, 2) int64 bonds that failed at this step
     side_touch: np.ndarray  # (P, 2) [s] soonest impact predicted on the side (an open sub-contact's gap / closing speed), inf none
-    side_impacting: np.ndarray  # (P, 2) bool a pressed unbonded sub-contact of the side moves at an impact speed (State.impact_speed)
+    side_impacting: np.ndarray  # (P, 2) bool a pressed unbonded sub-contact of the side moves at an impact speed, deeper than an impact (step.IMPACT_TAIL)
     blend_force_owner: np.ndarray  # (P, 3) [N] FACE: the weight's energy-gradient force on the owner's block ...
     blend_point_owner: np.ndarray  # (P, 3) [m] ... at this point (minus it on the target's block)
     blend_force_target: np.ndarray  # (P, 3) [N] ... and on the target's block

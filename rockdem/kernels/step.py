@@ -603,7 +603,8 @@ def advance(
     lasts longer) when the force pass predicts an impact (``sc.touch_time``, forces._law_range)
     within ``s.impact_window`` while the windows so far (``s.refined_time``) cover at most the share
     :data:`IMPACT_SHARE` of the time, and closes :data:`IMPACT_AFTER` windows after the predicted
-    touch (:func:`rockdem.timestep.impact_windows`).
+    touch, or later while the impact goes on (:data:`IMPACT_TAIL`, at most :data:`IMPACT_LONGEST`
+    windows after the touch; :func:`rockdem.timestep.impact_windows`).
     """
     while s.time[0] < t_stop - 1e-12 * max(1.0, t_stop):
         update_rotations(m, s, sc)
