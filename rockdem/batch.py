@@ -256,21 +256,28 @@ def _start(data: Mapping[str, Any], case: Case) -> Any:
     r = case.run
     key = json.dumps([template_key(data), case.model.damping.__dict__, case.model.arrays.mat_beta.tolist(), r.timestep_rule,
                       r.safety, r.resolution, r.dt, r.dashpots], sort_keys=True, default=str)
-    with _LOCK:
-        start = _STARTS.get(key)
-        if start is not None:
-            _STARTS.move_to_end(key)
-    if start is None:
-        start = prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety, resolution=r.resolution,
-                              dt=r.dt, dashpots=r.dashpots)
-        with _LOCK:
-            _STARTS[key] = start
-            while len(_STARTS) > TEMPLATE_CACHE:
-                _STARTS.popitem(last=False)
+    start = _cached(_STARTS, key, lambda: prepare_start(case.model, timestep_rule=r.timestep_rule, safety=r.safety,
+                                                        resolution=r.resolution, dt=r.dt, dashpots=r.dashpots))
     return start.copy()
 
 
 _SETTLED: OrderedDict[str, Any] = OrderedDict()
+
+
+def _cached(store: OrderedDict[str, Any], key: str, make: Any) -> Any:
+    """``store[key]``, made by ``make()`` when absent (outside the lock: it may run a model); the
+    last :data:`TEMPLATE_CACHE` used are kept."""
+    with _LOCK:
+        value = store.get(key)
+        if value is not None:
+            store.move_to_end(key)
+    if value is None:
+        value = make()
+        with _LOCK:
+            store[key] = value
+            while len(store) > TEMPLATE_CACHE:
+                store.popitem(last=False)
+    return value
 
 
 def _settled(data: Mapping[str, Any], case: Case) -> Any:
@@ -280,14 +287,7 @@ def _settled(data: Mapping[str, Any], case: Case) -> Any:
 
     r = case.run
     key = json.dumps([template_key(data), r.settle, r.timestep_rule, r.safety, r.resolution, r.dt], sort_keys=True, default=str)
-    with _LOCK:
-        ck = _SETTLED.get(key)
-    if ck is None:
-        ck, _ = settled_start(case)
-        with _LOCK:
-            _SETTLED[key] = ck
-            while len(_SETTLED) > TEMPLATE_CACHE:
-                _SETTLED.popitem(last=False)
+    ck = _cached(_SETTLED, key, lambda: settled_start(case)[0])
     return ck.reset_clock()
 
 

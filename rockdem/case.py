@@ -31,7 +31,7 @@ from .materials import JointMaterial, check_material, ks_from_kn
 from .model import Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
-from .stopping import STOP_MODES
+from .stopping import REST_WINDOW, STOP_MODES
 from .timestep import DASHPOT_SCHEMES, IMPACT_REFINEMENT
 
 __all__ = [
@@ -246,7 +246,7 @@ SETTLE_LONGEST = 2.0
 """[s] the longest settling of ``[run] settle = true`` (it ends earlier once the blocks are at rest)."""
 
 SETTLE_SHORTEST = 1.0
-"""[s] the shortest ``[run] settle`` accepted: rest is judged over 0.5 s of stillness (stopping.REST_WINDOW)."""
+"""[s] the shortest ``[run] settle`` accepted: rest is judged over :data:`rockdem.stopping.REST_WINDOW` of stillness."""
 
 SETTLE_LONGEST_ACCEPTED = 60.0
 """[s] the longest ``[run] settle`` accepted (blocks that do not settle in a minute do not stand)."""
@@ -558,7 +558,7 @@ def _settle_time(run_t: Table) -> float:
         raise ValueError(f"[{run_t.where}] settle must be true, false or the longest settling time [s], got {v!r}")
     if v > 0 and not SETTLE_SHORTEST <= v <= SETTLE_LONGEST_ACCEPTED:
         raise ValueError(f"[{run_t.where}] settle = {v!r} s: give from {SETTLE_SHORTEST:g} s (rest is judged over "
-                         "0.5 s of stillness) to {SETTLE_LONGEST_ACCEPTED:g} s, or true ({SETTLE_LONGEST:g} s at most)")
+                         f"{REST_WINDOW:g} s of stillness) to {SETTLE_LONGEST_ACCEPTED:g} s, or true ({SETTLE_LONGEST:g} s at most)")
     return float(v)
 
 

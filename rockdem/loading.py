@@ -828,7 +828,7 @@ def _earthquake(t: Table, b: ModelBuilder, monitors: dict[str, Monitor], ctx: di
         earthquake_record=info.motion.name,
         earthquake_mode=info.mode,
         earthquake_pga_m_s2=info.pga,
-        earthquake_pga_time_s=info.pga_time,  # a run ending before it is warned about (run_cli.run_options)
+        earthquake_pga_time_s=info.pga_time,  # a run ending before it is warned about (run_cli.run_case)
         earthquake_duration_s=float(info.time[-1]),
     )
     ctx["series"]["ground_acceleration"] = (info.time, info.acceleration)

@@ -41,9 +41,13 @@ def settled_start(case: Case) -> tuple[Checkpoint, float]:
     """The start of a case with ``[run] settle``: its model settled under gravity alone (the same
     blocks and joints, no loading, local damping :data:`SETTLE_LOCAL_DAMPING`) until its blocks
     are at rest or for ``case.run.settle`` seconds at most, its clock reset (docs/checkpoints.md,
-    "Settle once"), and the settling's length [s]. Raises ValueError where they did not come to rest. Gravity loads the joints' springs from zero at t = 0: without settling, they
-    ring about their static overlaps between no force and twice the weight, for ever undamped and
-    for about 2 / alpha seconds with mass-proportional damping alone."""
+    "Settle once"), and the settling's length [s]. Gravity loads the joints' springs from zero at
+    t = 0: without settling, they ring about their static overlaps between no force and twice the
+    weight, for ever undamped and for about 2 / alpha seconds with mass-proportional damping alone.
+
+    Raises:
+        ValueError: the loading moves or adds blocks, or the blocks did not come to rest in time.
+    """
     data = copy.deepcopy(case.data)
     data["loading"] = {"type": "gravity"}
     data["damping"] = {"local": SETTLE_LOCAL_DAMPING}
