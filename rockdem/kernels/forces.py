@@ -31,7 +31,7 @@ from .contact import (
 )
 from .blend import blend_weight, face_clearance, tracks_target
 from .detect import edge_contact
-from .faces import anchored_overlap, crossing_lines, cut_cell, face_map_arrays
+from .faces import anchored_overlap, cell_above, crossing_lines, cut_cell, face_map_arrays
 from .layout import (
     DASHPOTS_IMPLICIT,
     E_BOND,
@@ -585,14 +585,14 @@ def _open_cell_touch(
     impact_speed: float,
 ) -> float:
     """Time [s] until the open, unbonded cell of point p, wholly above face ft's plane (the joint
-    law skips it: faces.cut_cell's ``open_before``), touches the part of it that face ft covers,
+    law skips it: faces.cell_above), touches the part of it that face ft covers,
     at its present closing speed, if that speed exceeds ``impact_speed``; +inf otherwise. A face
     landing across its partner's edge is seen by these cells only (docs/dashpots.md). Out of line,
     called only while a partly covered pair may close that fast (:func:`_closing_bound`)."""
     area, yu, yw, shift, _, _, _, _, _ = cut_cell(
         m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
         m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
-        True, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]), False,
+        True, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
     )
     if area <= 0.0:
         return np.inf
@@ -658,13 +658,17 @@ def _law_range(
             full_area, yu, yw, shift = m.point_area[p], m.point_node[p, 0], m.point_node[p, 1], 0.0
         elif mask == -2:
             full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
+        elif not s.slot_bonded[p, j] and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0) and cell_above(
+                m.point_cell_start, m.cell_vertex, p, fm.h0, fm.hu, fm.hw):
+            # Unbonded, open at the last step and wholly above the target plane: it stays open
+            # whatever its cover (faces.cell_above; no call of faces.cut_cell).
+            full_area, yu, yw, shift = 0.0, m.point_node[p, 0], m.point_node[p, 1], 0.0
         else:
             unbonded = not s.slot_bonded[p, j]
             full_area, yu, yw, shift, cover_w, au, aw, eu, ew = cut_cell(
                 m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, buf,
                 m.point_node[p, 0], m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask,
                 unbonded, m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
-                unbonded and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0),
             )
         shift -= s.slot_set[p, j]  # an unbonded sub-contact's set (below): its overlap is measured from it
         if dashpots:
