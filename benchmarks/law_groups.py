@@ -8,6 +8,11 @@ crosses the owner face: bed and head joints), *cut* (cells clipped by a target e
 head faces of diagonal neighbours, overlapping by the sliver of the settlement difference) and
 faces at right angles. Each group's law (``forces._law_pair``) runs 100 times on a copy of the
 settled state, best of three rounds (docs/performance.md, "A third machine").
+
+A second table gives the cost per *pair* in cache: the first 300 pairs of a group, each cut to its
+first k sub-contacts (k = 0, 1, all), 2,000 passes. These figures held within about 10 % from
+run to run on the shared 2-core machine while the whole-wall ones above swung by up to 2 x
+(docs/performance.md, "The wall on 2026-11-30"): use them to compare versions of the law.
 """
 
 from __future__ import annotations
@@ -83,6 +88,22 @@ def main() -> None:
             best = min(best, (time.perf_counter() - t0) / 100)
         count = int(per_pair[pairs].sum())
         print(f"{name:>15} {pairs.size:>6} {count:>12} {1e3 * best:>11.3f} {1e9 * best / count:>18.0f}")
+    print("in cache, ns per pair (300 pairs) with its first k sub-contacts: k = 0, 1, all (mean count)")
+    for name in ("flush", "cut"):
+        pairs = groups[name][:300]
+        if pairs.size == 0:
+            continue
+        line = []
+        for keep in (0, 1, 1 << 30):
+            copy = start.copy()
+            st = copy.state
+            st.pair_track_stop[:] = np.minimum(st.pair_track_start + keep, s.pair_track_stop)
+            st.pair_track_split[:] = np.minimum(st.pair_track_split, st.pair_track_stop)
+            t0 = time.perf_counter()
+            _laws(m, st, copy.scratch, dt, pairs, 2000)
+            mean = float((st.pair_track_stop - st.pair_track_start)[pairs].mean())
+            line.append(f"{1e9 * (time.perf_counter() - t0) / 2000 / pairs.size:.0f} ({mean:.2f})")
+        print(f"{name:>15}: " + ", ".join(line))
 
 
 if __name__ == "__main__":
