@@ -107,10 +107,19 @@ def bench_wall(courses: int = 40, per_course: int = 25) -> None:
                 best[n] = (rate, updates / cpu)
             print(f"    {n} thread(s): {steps} steps in {runtime:.2f} s ({cpu:.2f} s of CPU time, model start and results included),"
                   f" {updates / steps:.0f} sub-contacts per step on average")
-    print(f"(b) wall of {courses * per_course} bricks, {tracked} tracked sub-contacts at the start")
+    print(f"(b) wall of {courses * per_course} bricks, {tracked} tracked sub-contacts at the start;"
+          f" this machine now: {_reference_s():.2f} s for sum(range(10**8)) (docs/performance.md compares runs by it)")
     for n, (rate, per_cpu) in best.items():
         print(f"    sub-contact updates per second, {n} thread(s): {rate:.3e} (per CPU second {per_cpu:.3e}),"
               f" {rate / best[1][0]:.2f} x one thread")
+
+
+def _reference_s() -> float:
+    """Seconds the interpreter takes for ``sum(range(10**8))``: the shared machine's speed drifts
+    by up to 2 x for the wall (docs/performance.md), so its figures are read beside this one."""
+    t0 = time.perf_counter()
+    sum(range(10**8))
+    return time.perf_counter() - t0
 
 
 def bench_cold_start() -> None:
