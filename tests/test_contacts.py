@@ -204,3 +204,29 @@ def test_the_allocation_free_sort_orders_as_a_stable_argsort():
         sort_indices(keys, order, n)
         assert np.array_equal(order[:n], np.argsort(keys, kind="stable"))
         assert np.all(order[n:] == -7)
+
+
+def test_face_clearance_is_the_least_height_of_the_other_blocks_vertices(rng):
+    """blend.face_clearance (the clarity of kernels.blend) against plain NumPy: the least height
+    n . (R v + x - c) - offset of the other block's world vertices above a face's plane, that
+    vertex and the face's world normal, for random shapes, turns and places far from the origin."""
+    from rockdem.kernels.blend import face_clearance
+
+    for trial in range(300):
+        counts = rng.integers(4, 14, size=2)
+        local = rng.normal(size=(int(counts.sum()), 3)) * rng.uniform(0.01, 2.0)
+        start = np.array([0, counts[0], counts.sum()])
+        rot = np.stack([axis_angle_matrix(rng.normal(size=3), rng.uniform(0, np.pi)) for _ in range(2)])
+        pos = rng.normal(size=(2, 3)) * 10.0 ** rng.uniform(-2, 3)
+        normal = rng.normal(size=(1, 3))
+        normal /= np.linalg.norm(normal)
+        offset = rng.normal(size=1)
+        sep, x0, x1, x2, n0, n1, n2 = face_clearance(normal, offset, np.array([0]), start, local, rot, pos, 0, 1)
+        n = rot[0] @ normal[0]
+        world = local[start[1]:] @ rot[1].T + pos[1]
+        heights = (world - pos[0]) @ n - offset[0]
+        scale = 1e-13 * (1.0 + np.abs(pos).max() + np.abs(local).max())
+        assert abs(sep - heights.min()) <= scale, f"trial {trial}"
+        assert np.allclose([n0, n1, n2], n, atol=1e-15)
+        # the vertex returned is (one of) the lowest
+        assert abs(((np.array([x0, x1, x2]) - pos[0]) @ n - offset[0]) - heights.min()) <= scale
