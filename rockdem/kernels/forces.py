@@ -452,6 +452,8 @@ def _prefetch_pair(m: ModelArrays, s: State, sc: Scratch, q: int) -> None:
     ft = s.pair_target_face[q]
     ba = m.face_block[fo]
     bb = m.face_block[ft]
+    # Written out pair by pair: the same prefetches as loops over the two blocks and faces gained
+    # nothing (the loop's layout, docs/performance.md).
     prefetch(sc.rotation, (ba, 0, 0))
     prefetch(sc.rotation, (bb, 0, 0))
     prefetch(s.position, (ba, 0))
