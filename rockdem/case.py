@@ -28,7 +28,7 @@ from ._warn import warn_user
 from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
 from .geometry import MAX_FACE_POINTS, MAX_LENGTH
 from .materials import JointMaterial, check_material, ks_from_kn
-from .model import Damping, Model, ModelBuilder
+from .model import SETTLE_HINT, Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
 from .stopping import REST_WINDOW, STOP_MODES
@@ -655,7 +655,7 @@ class CaseTemplate:
         ctx = _loading(top, builder, monitors, run)
         output = _output(top)
         top.finish()
-        with _chosen_damping(data):
+        with _chosen_damping(data, run.settle > 0.0):
             model = builder.finalize(damping=damping, rocking_axis=ctx.get("rocking_axis"),
                                      contact_tolerance=run.contact_tolerance)
         self._ctx = ctx
@@ -691,14 +691,14 @@ class CaseTemplate:
         if self._swap:
             builder, monitors = copy.copy(self._bare), dict(self._monitors)
             ctx = _loading(top, builder, monitors, run)
-            with _chosen_damping(data):
+            with _chosen_damping(data, run.settle > 0.0):
                 model = model.with_inputs(damping=damping, builder=builder, beta_choice=self.beta_choice(damping))
             axis = np.asarray(ctx.get("rocking_axis", builder.default_rocking_axis()), dtype=float)  # the load's own direction
             model = dataclasses.replace(model, rocking_axis=axis / np.linalg.norm(axis))
         else:
             top.used.add("loading")
             ctx, monitors = self._ctx, dict(self.case.monitors)
-            with _chosen_damping(data):
+            with _chosen_damping(data, run.settle > 0.0):
                 model = model.with_inputs(damping=damping, beta_choice=self.beta_choice(damping))
         output = _output(top)
         top.finish()
@@ -706,15 +706,27 @@ class CaseTemplate:
 
 
 @contextlib.contextmanager
-def _chosen_damping(data: Mapping[str, Any]) -> Iterator[None]:
+def _chosen_damping(data: Mapping[str, Any], settled: bool = False) -> Iterator[None]:
     """Within the block, no warning about an undamped model when the case's ``[damping]`` states
     alpha or beta itself (``beta = 0.0``: an undamped model by choice, e.g. the paper's
-    discretised non-damped strategy, §3.2); without them it warns (model._warn_implausible_damping)."""
+    discretised non-damped strategy, §3.2); without them it warns (model._warn_implausible_damping),
+    and for a case that settles its blocks (``settled``: ``[run] settle``) without suggesting
+    settling (:data:`rockdem.model.SETTLE_HINT`): the block's warnings are then caught and issued
+    again as they leave it."""
     table = data.get("damping")
-    with warnings.catch_warnings():
-        if isinstance(table, Mapping) and ("beta" in table or "alpha" in table):
-            warnings.filterwarnings("ignore", message="no damping", category=UserWarning)
-        yield
+    caught: list[warnings.WarningMessage] = []
+    try:
+        with warnings.catch_warnings(record=settled) as seen:
+            if settled:
+                warnings.simplefilter("always")  # caught here, filtered as the caller's when issued again
+                caught = seen
+            if isinstance(table, Mapping) and ("beta" in table or "alpha" in table):
+                warnings.filterwarnings("ignore", message="no damping", category=UserWarning)
+            yield
+    finally:
+        for w in caught:
+            text = str(w.message)
+            warn_user(text.replace(SETTLE_HINT, "") if text.startswith("no damping") else text, w.category)
 
 
 _AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")

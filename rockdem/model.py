@@ -979,6 +979,10 @@ OVERDAMPED_BETA = 10.0
 """A numeric beta this many times the critical value 2 / omega of the model's slowest impact is
 warned about (:func:`_warn_implausible_damping`; DeJong's beta, paper §2.2, is a critical one)."""
 
+SETTLE_HINT = ", or start from the blocks settled (a case's [run] settle = true)"
+"""The undamped-model warning's last suggestion, left out for a case that settles its blocks
+(:func:`rockdem.case._chosen_damping`)."""
+
 
 UNDAMPED_HINT = 0.4
 """The share of the critical beta of the slowest impact that the warning about an undamped model
@@ -1046,7 +1050,7 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
             "decays; a block held by friction near its limit (on a slope, in a wedge) creeps at every cycle (1 mm/s "
             "on a 20 deg slope at a 30 deg friction angle) and sliding outruns Coulomb's law by up to 20 %; a small "
             f"SP damping removes both, e.g. damping.beta = {UNDAMPED_HINT * critical:.2g} s ({UNDAMPED_HINT:.0%} of "
-            "critical on the slowest impact), or start from the blocks settled (a case's [run] settle = true)")
+            f"critical on the slowest impact){SETTLE_HINT}")
         return
     if not beta > 0.0:
         return

@@ -147,6 +147,22 @@ def test_the_undamped_warning_stays_quiet_for_damped_joints_and_an_undamped_case
         parse_case(data)
 
 
+def test_the_undamped_warning_suggests_settling_only_to_a_case_that_does_not_settle():
+    data = example_case("free-rocking")
+    data.pop("damping", None)
+    for settle in (False, True):
+        data.setdefault("run", {})["settle"] = settle
+        with pytest.warns(UserWarning, match="no damping") as caught:
+            parse_case(data)
+        text = " ".join(str(w.message) for w in caught if "no damping" in str(w.message))
+        assert ("settle = true" in text) is not settle
+        assert all(w.filename == __file__ for w in caught)  # the user's line, not the case module's
+    with warnings.catch_warnings():  # the caller's filters still apply to the warning issued again
+        warnings.simplefilter("error")
+        with pytest.raises(UserWarning, match="no damping"):
+            parse_case(data)
+
+
 def test_dt_above_the_stable_bound_is_refused_with_the_bound():
     model = rocking_block(damping=Damping(beta=0.00693))
     bound = stable_timestep(model).critical
