@@ -712,13 +712,15 @@ def _chosen_damping(data: Mapping[str, Any], settled: bool = False) -> Iterator[
     discretised non-damped strategy, §3.2); without them it warns (model._warn_implausible_damping),
     and for a case that settles its blocks (``settled``: ``[run] settle``) without suggesting
     settling (:data:`rockdem.model.SETTLE_HINT`): the block's warnings are then caught and issued
-    again as they leave it."""
+    again as they leave it, that one without the hint under the caller's filters, the others as
+    they were (their own place)."""
     table = data.get("damping")
     caught: list[warnings.WarningMessage] = []
     try:
         with warnings.catch_warnings(record=settled) as seen:
             if settled:
-                warnings.simplefilter("always")  # caught here, filtered as the caller's when issued again
+                # caught whatever the caller's filters say (they apply when it is issued again)
+                warnings.filterwarnings("always", message="no damping", category=UserWarning)
                 caught = seen
             if isinstance(table, Mapping) and ("beta" in table or "alpha" in table):
                 warnings.filterwarnings("ignore", message="no damping", category=UserWarning)
@@ -726,7 +728,10 @@ def _chosen_damping(data: Mapping[str, Any], settled: bool = False) -> Iterator[
     finally:
         for w in caught:
             text = str(w.message)
-            warn_user(text.replace(SETTLE_HINT, "") if text.startswith("no damping") else text, w.category)
+            if text.startswith("no damping"):
+                warn_user(text.replace(SETTLE_HINT, ""), w.category)
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
 
 
 _AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")
