@@ -13,6 +13,11 @@ A second table gives the cost per *pair* in cache: the first 300 pairs of a grou
 first k sub-contacts (k = 0, 1, all), 2,000 passes. These figures held within about 10 % from
 run to run on the shared 2-core machine while the whole-wall ones above swung by up to 2 x
 (docs/performance.md, "The wall on 2026-11-30"): use them to compare versions of the law.
+
+A third line gives the clipping alone (``faces.cut_cell``, compiled out of line as the law calls
+it) per cell that the law clips, in cache, 200 passes, with the face map computed as the law
+does: a measure of the clipping that the law's compiled loop does not blur
+(docs/performance.md, "twelfth session").
 """
 
 from __future__ import annotations
@@ -28,9 +33,9 @@ from numba import njit
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_engine import wall_model  # noqa: E402
 
-from rockdem.kernels.faces import crossing_lines, face_map_arrays  # noqa: E402
+from rockdem.kernels.faces import cell_above, crossing_lines, cut_cell, face_map_arrays  # noqa: E402
 from rockdem.kernels.forces import _law_pair  # noqa: E402
-from rockdem.kernels.layout import PAIR_EDGE  # noqa: E402
+from rockdem.kernels.layout import PAIR_EDGE, SLOTS  # noqa: E402
 from rockdem.simulation import prepare_start, run_model  # noqa: E402
 
 EDGE = -9  # an EDGE pair (no cover)
@@ -54,6 +59,52 @@ def _laws(m, s, sc, dt, pairs, reps):  # type: ignore[no-untyped-def]
     for _ in range(reps):
         for i in pairs:
             _law_pair(m, s, sc, i, dt, False, False, sc.poly)
+
+
+@njit(_nrt=False)
+def _clipped_cells(m, s, sc, out):  # type: ignore[no-untyped-def]
+    """(pair, track index) of every sub-contact whose cell the law clips (faces.cut_cell), as
+    forces._law_range picks them (owner side: the wall's cut pairs do not blend); their count."""
+    n = 0
+    for i in range(s.pair_count[0]):
+        if s.pair_kind[i] == PAIR_EDGE:
+            continue
+        fo, ft = s.pair_owner_face[i], s.pair_target_face[i]
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+        mask = -2 if abs(fm.det) < 1e-9 else crossing_lines(
+            m.face_corner_start, m.face_corner_uw, m.face_line_start, m.face_line, fo, ft, fm)
+        if mask == 0 or mask == -2:
+            continue
+        for k in range(s.pair_track_start[i], s.pair_track_split[i]):
+            p = s.track[k] // SLOTS
+            j = s.track[k] - SLOTS * p
+            if not s.slot_bonded[p, j] and (s.slot_overlap[p, j] <= 0.0 or s.slot_area[p, j] == 0.0) and cell_above(
+                    m.point_cell_start, m.cell_vertex, p, fm.h0, fm.hu, fm.hw):
+                continue
+            out[n, 0] = i
+            out[n, 1] = k
+            out[n, 2] = mask
+            n += 1
+    return n
+
+
+@njit(_nrt=False)
+def _clip_cells(m, s, sc, cells, reps):  # type: ignore[no-untyped-def]
+    total = 0.0
+    for _ in range(reps):
+        for c in range(cells.shape[0]):
+            i, k, mask = cells[c, 0], cells[c, 1], cells[c, 2]
+            ft = s.pair_target_face[i]
+            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position,
+                                 s.pair_owner_face[i], ft)
+            p = s.track[k] // SLOTS
+            j = s.track[k] - SLOTS * p
+            total += cut_cell(
+                m.point_cell_start, m.cell_vertex, m.face_line_start, m.face_line, sc.poly, m.point_node[p, 0],
+                m.point_node[p, 1], m.point_area[p], m.touch_tol, p, ft, fm, 0.0, mask, not s.slot_bonded[p, j],
+                m.face_area[ft] / (m.face_point_start[ft + 1] - m.face_point_start[ft]),
+            )[0]
+    return total
 
 
 def main() -> None:
@@ -104,6 +155,16 @@ def main() -> None:
             mean = float((st.pair_track_stop - st.pair_track_start)[pairs].mean())
             line.append(f"{1e9 * (time.perf_counter() - t0) / 2000 / pairs.size:.0f} ({mean:.2f})")
         print(f"{name:>15}: " + ", ".join(line))
+    cells = np.zeros((int(s.track_count[0]), 3), dtype=np.int64)
+    cells = cells[:_clipped_cells(m, s, start.scratch, cells)]
+    _clip_cells(m, s, start.scratch, cells, 1)  # compile
+    best = np.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        _clip_cells(m, s, start.scratch, cells, 200)
+        best = min(best, (time.perf_counter() - t0) / 200)
+    print(f"clipping alone (faces.cut_cell, face map included), in cache: {len(cells)} cells, "
+          f"{1e9 * best / max(len(cells), 1):.0f} ns per cell")
 
 
 if __name__ == "__main__":

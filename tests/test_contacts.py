@@ -230,3 +230,81 @@ def test_face_clearance_is_the_least_height_of_the_other_blocks_vertices(rng):
         assert np.allclose([n0, n1, n2], n, atol=1e-15)
         # the vertex returned is (one of) the lowest
         assert abs(((np.array([x0, x1, x2]) - pos[0]) @ n - offset[0]) - heights.min()) <= scale
+
+
+def _clip_area(poly, lu, lw, lo):
+    """Area of the part of convex polygon ``poly`` (n, 2) with lu x + lw y <= lo (plain NumPy:
+    the vertices inside and the edges' crossings, ordered by angle about their mean)."""
+    d = poly @ np.array([lu, lw]) - lo
+    pts = [poly[k] for k in range(len(poly)) if d[k] <= 0.0]
+    for k in range(len(poly)):
+        q = (k + 1) % len(poly)
+        if (d[k] < 0.0 < d[q]) or (d[q] < 0.0 < d[k]):
+            pts.append(poly[k] + d[k] / (d[k] - d[q]) * (poly[q] - poly[k]))
+    if len(pts) < 3:
+        return 0.0
+    pts = np.array(pts)
+    c = pts.mean(axis=0)
+    pts = pts[np.argsort(np.arctan2(pts[:, 1] - c[1], pts[:, 0] - c[0]))]
+    x, y = pts[:, 0], pts[:, 1]
+    return 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def test_a_quad_cell_cut_by_one_line_is_clipped_as_the_generic_polygon_is(rng):
+    """faces.cut_cell's path for a four-vertex cell crossed by one target edge line (the usual cut
+    cell: a face sliding off its partner's edge, a wall's diagonal neighbours) gives what the
+    generic covered + partly_covered give, bit for bit, for random cells (rectangles and random
+    convex quads), face maps (turned, mirrored, sheared, tilted) and lines (through a vertex too),
+    lumped or not; and its effective area is the clipped cell's area of plain NumPy."""
+    from rockdem.kernels.faces import (
+        COVER_FULL, COVER_NONE, COVER_PART, FaceMap, _cut_quad, covered, partly_covered,
+    )
+
+    buf = np.zeros((2, 32, 2))
+    cell_start = np.array([0, 4])
+    line_start = np.array([0, 4])
+    partial = 0
+    for trial in range(3000):
+        centre = rng.uniform(-0.1, 0.1, 2)
+        half = rng.uniform(1e-3, 0.05, 2)
+        quad = centre + half * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+        if trial % 3 == 0:  # a random convex quad (counter-clockwise)
+            quad = quad + rng.normal(0.0, 0.2 * half.min(), quad.shape)
+            e = np.roll(quad, -1, axis=0) - quad
+            if (e[:, 0] * np.roll(e, -1, axis=0)[:, 1] - e[:, 1] * np.roll(e, -1, axis=0)[:, 0] <= 0.0).any():
+                continue
+        turn = rng.uniform(0.0, 2.0 * np.pi)
+        mirror = rng.choice([-1.0, 1.0])
+        m00, m01, m10, m11 = np.cos(turn), -np.sin(turn) * mirror, np.sin(turn), np.cos(turn) * mirror
+        if trial % 5 == 0:  # a slanted target: the map is not a rotation
+            m01 *= rng.uniform(0.3, 1.0)
+        t0, t1 = rng.uniform(-0.05, 0.05, 2)
+        h0 = rng.normal(0.0, 1e-4) if trial % 2 else 0.0
+        hu, hw = rng.normal(0.0, 1e-3, 2) if trial % 4 else (0.0, 0.0)
+        fm = FaceMap(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0,
+                     m00, m01, m10, m11, t0, t1, h0, hu, hw, m00 * m11 - m01 * m10)
+        side = rng.uniform(0.01, 0.2)
+        lines = np.array([[1.0, 0.0, side], [0.0, 1.0, side], [-1.0, 0.0, side], [0.0, -1.0, side]])
+        li = int(rng.integers(4))
+        mapped = quad @ np.array([[m00, m10], [m01, m11]]) + [t0, t1]
+        if trial % 10 == 0:  # the line through a cell vertex
+            lines[li, 2] = lines[li, :2] @ mapped[rng.integers(4)]
+        node = quad.mean(axis=0) if trial % 5 else quad[rng.integers(4)]
+        area = 0.5 * abs(np.dot(quad[:, 0], np.roll(quad[:, 1], -1)) - np.dot(np.roll(quad[:, 0], -1), quad[:, 1]))
+        lumped = bool(trial % 3)
+        cap = rng.uniform(1e-4, 1e-2)
+        mask = 1 << li
+        fast = _cut_quad(cell_start, quad, lines, li, buf, node[0], node[1], area, 1e-5, 0, fm, 0.0, lumped, cap)
+        state = covered(cell_start, quad, line_start, lines, 0, 0, fm, 0.0, mask)
+        if state == COVER_FULL:
+            generic = (area, node[0], node[1], 0.0, 0.0, node[0], node[1], node[0], node[1])
+        elif state == COVER_NONE:
+            generic = (0.0, node[0], node[1], 0.0, 0.0, node[0], node[1], node[0], node[1])
+        else:
+            partial += 1
+            generic = partly_covered(cell_start, quad, line_start, lines, buf, node[0], node[1], area, 1e-5, 0, 0, fm,
+                                     0.0, lumped, cap, mask)
+        assert np.array_equal(np.array(fast).view(np.int64), np.array(generic).view(np.int64)), f"trial {trial}"
+        if state == COVER_PART and not lumped:
+            assert fast[0] == pytest.approx(_clip_area(mapped, *lines[li]) / abs(fm.det), rel=1e-9), f"trial {trial}"
+    assert partial > 300

@@ -328,6 +328,17 @@ def partly_covered(
                 node_in = False
             n = clip_halfplane(buf, cur, n, lu, lw, lo)
             cur = 1 - cur
+    return _cover_tail(cell_start, cell_vertex, buf, cur, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _cover_tail(
+    cell_start: np.ndarray, cell_vertex: np.ndarray, buf: np.ndarray, cur: int, n: int, xu: float, xw: float,
+    node_in: bool, nu: float, nw: float, point_area: float, touch_tol: float, p: int, fm: FaceMap, lumped: bool,
+    target_cell_area: float,
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """:func:`partly_covered` from the cell's covered part ``buf[cur, :n]`` (target coordinates)
+    on: point (nu, nw) maps to (xu, xw), inside the target when ``node_in``."""
     area = abs(polygon_area(buf, cur, n)) / abs(fm.det) if n >= 3 else 0.0
     yu, yw = nu, nw
     shift = 0.0
@@ -422,6 +433,69 @@ def cell_above(cell_start: np.ndarray, cell_vertex: np.ndarray, p: int, h0: floa
     return True
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _clip_step(
+    buf: np.ndarray, j: int, out: int, px: float, py: float, dp: float, cx: float, cy: float, dc: float
+) -> int:
+    """One edge (p -> c, signed distances dp, dc) of :func:`clip_halfplane`, written to buf[j]
+    from index ``out``; returns the new count (the same arithmetic, bit for bit)."""
+    if dc <= 0.0:
+        if dp > 0.0:
+            t = dp / (dp - dc)
+            buf[j, out, 0] = px + t * (cx - px)
+            buf[j, out, 1] = py + t * (cy - py)
+            out += 1
+        buf[j, out, 0] = cx
+        buf[j, out, 1] = cy
+        out += 1
+    elif dp <= 0.0:
+        t = dp / (dp - dc)
+        buf[j, out, 0] = px + t * (cx - px)
+        buf[j, out, 1] = py + t * (cy - py)
+        out += 1
+    return out
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _cut_quad(
+    cell_start: np.ndarray, cell_vertex: np.ndarray, line: np.ndarray, li: int, buf: np.ndarray,
+    nu: float, nw: float, point_area: float, touch_tol: float, p: int, fm: FaceMap, grow: float,
+    lumped: bool, target_cell_area: float,
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """:func:`cut_cell` of a four-vertex cell against the one target edge line ``li`` that crosses
+    its face: :func:`covered` and :func:`partly_covered` in one pass, the cell's corners mapped
+    once and clipped unrolled. The same arithmetic in the same order, so the same answer bit for
+    bit for finite input (tests/test_contacts.py checks it on random cells, maps and lines)."""
+    c0 = cell_start[p]
+    a0 = fm.m00 * cell_vertex[c0, 0] + fm.m01 * cell_vertex[c0, 1] + fm.t0
+    b0 = fm.m10 * cell_vertex[c0, 0] + fm.m11 * cell_vertex[c0, 1] + fm.t1
+    a1 = fm.m00 * cell_vertex[c0 + 1, 0] + fm.m01 * cell_vertex[c0 + 1, 1] + fm.t0
+    b1 = fm.m10 * cell_vertex[c0 + 1, 0] + fm.m11 * cell_vertex[c0 + 1, 1] + fm.t1
+    a2 = fm.m00 * cell_vertex[c0 + 2, 0] + fm.m01 * cell_vertex[c0 + 2, 1] + fm.t0
+    b2 = fm.m10 * cell_vertex[c0 + 2, 0] + fm.m11 * cell_vertex[c0 + 2, 1] + fm.t1
+    a3 = fm.m00 * cell_vertex[c0 + 3, 0] + fm.m01 * cell_vertex[c0 + 3, 1] + fm.t0
+    b3 = fm.m10 * cell_vertex[c0 + 3, 0] + fm.m11 * cell_vertex[c0 + 3, 1] + fm.t1
+    lu = line[li, 0]
+    lw = line[li, 1]
+    lo = line[li, 2] + grow
+    d0 = lu * a0 + lw * b0 - lo
+    d1 = lu * a1 + lw * b1 - lo
+    d2 = lu * a2 + lw * b2 - lo
+    d3 = lu * a3 + lw * b3 - lo
+    if not max(max(d0, d1), max(d2, d3)) > INSIDE_TOL:  # (the tests of covered())
+        return point_area, nu, nw, 0.0, 0.0, nu, nw, nu, nw
+    if min(min(d0, d1), min(d2, d3)) >= -INSIDE_TOL:
+        return 0.0, nu, nw, 0.0, 0.0, nu, nw, nu, nw
+    xu = fm.m00 * nu + fm.m01 * nw + fm.t0
+    xw = fm.m10 * nu + fm.m11 * nw + fm.t1
+    node_in = not lu * xu + lw * xw - lo > INSIDE_TOL
+    n = _clip_step(buf, 1, 0, a3, b3, d3, a0, b0, d0)
+    n = _clip_step(buf, 1, n, a0, b0, d0, a1, b1, d1)
+    n = _clip_step(buf, 1, n, a1, b1, d1, a2, b2, d2)
+    n = _clip_step(buf, 1, n, a2, b2, d2, a3, b3, d3)
+    return _cover_tail(cell_start, cell_vertex, buf, 1, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area)
+
+
 @njit(cache=True, _nrt=False)
 def cut_cell(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line_start: np.ndarray, line: np.ndarray, buf: np.ndarray,
@@ -436,7 +510,16 @@ def cut_cell(
     :func:`partly_covered` (``lumped``, ``target_cell_area`` as there) where the cell is cut.
     Compiled out of line, so that the joint law's loop stays small for flush joints. (An unbonded
     cell open at the last step and wholly above the target plane, :func:`cell_above`, is not
-    clipped at all: the joint law tests that first.)"""
+    clipped at all: the joint law tests that first.) A four-vertex cell crossed by one line (most
+    cut cells: a face sliding off its partner's edge, a wall's diagonal neighbours) takes
+    :func:`_cut_quad`, the same answer bit for bit in fewer operations (settled 1000-brick wall:
+    75 against 83 ns per cut cell in cache, docs/performance.md)."""
+    if mask > 0 and mask & (mask - 1) == 0 and cell_start[p + 1] - cell_start[p] == 4:
+        li = line_start[ft]
+        while not mask & 1:
+            mask >>= 1
+            li += 1
+        return _cut_quad(cell_start, cell_vertex, line, li, buf, nu, nw, point_area, touch_tol, p, fm, grow, lumped, target_cell_area)
     state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, grow, mask)
     if state == COVER_FULL:
         return point_area, nu, nw, 0.0, 0.0, nu, nw, nu, nw

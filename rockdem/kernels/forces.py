@@ -813,14 +813,18 @@ def _law_range(
             un, e_set = cover_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn, deepened, cut and not blending)
             shift += un - un_cover
             e_fric += e_set
-        s.slot_cover[p, j] = cover_w
+        # Stored only when they change: a settled joint's lines of these arrays stay clean and are not
+        # written back (the 1000-brick wall's working set is larger than the caches).
+        if s.slot_cover[p, j] != cover_w:
+            s.slot_cover[p, j] = cover_w
         if cover_w > 0.0:
             s.slot_anchor[p, j, 0] = au
             s.slot_anchor[p, j, 1] = aw
             s.slot_deepest[p, j, 0] = eu
             s.slot_deepest[p, j, 1] = ew
         s.slot_overlap[p, j] = un if area > 0.0 else min(un, 0.0)
-        s.slot_area[p, j] = area
+        if s.slot_area[p, j] != area:
+            s.slot_area[p, j] = area
         vs0, vs1, vs2 = v0 - vn * n0, v1 - vn * n1, v2 - vn * n2
         kna = kn * area
         ksa = ks * area
