@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit
 
 from .layout import ModelArrays, Scratch, State
-from .polygon import clip_halfplane, deepest_vertex, nearest_on_polygon, polygon_area
+from .polygon import clip_edge, clip_halfplane, deepest_vertex, nearest_on_polygon, polygon_area
 
 INSIDE_TOL = 1e-10
 """[m] a cell vertex this close outside a target edge counts as inside (round-off of flush joints)."""
@@ -129,6 +129,24 @@ def face_map_arrays(
     )
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _quad_to_target(
+    cell_vertex: np.ndarray, c0: int, fm: FaceMap
+) -> tuple[float, float, float, float, float, float, float, float]:
+    """The four vertices ``cell_vertex[c0:c0 + 4]`` of a cell in the target face's coordinates:
+    (u'_0, w'_0, ..., u'_3, w'_3) [m] (the arithmetic of :func:`_cell_to_target`)."""
+    return (
+        fm.m00 * cell_vertex[c0, 0] + fm.m01 * cell_vertex[c0, 1] + fm.t0,
+        fm.m10 * cell_vertex[c0, 0] + fm.m11 * cell_vertex[c0, 1] + fm.t1,
+        fm.m00 * cell_vertex[c0 + 1, 0] + fm.m01 * cell_vertex[c0 + 1, 1] + fm.t0,
+        fm.m10 * cell_vertex[c0 + 1, 0] + fm.m11 * cell_vertex[c0 + 1, 1] + fm.t1,
+        fm.m00 * cell_vertex[c0 + 2, 0] + fm.m01 * cell_vertex[c0 + 2, 1] + fm.t0,
+        fm.m10 * cell_vertex[c0 + 2, 0] + fm.m11 * cell_vertex[c0 + 2, 1] + fm.t1,
+        fm.m00 * cell_vertex[c0 + 3, 0] + fm.m01 * cell_vertex[c0 + 3, 1] + fm.t0,
+        fm.m10 * cell_vertex[c0 + 3, 0] + fm.m11 * cell_vertex[c0 + 3, 1] + fm.t1,
+    )
+
+
 COVER_FULL = 1
 COVER_NONE = 0
 COVER_PART = -1
@@ -200,14 +218,7 @@ def covered(
     nv = cell_start[p + 1] - c0
     l0 = line_start[ft]
     if nv == 4:  # the usual rectangular cell: its corners mapped once
-        a0 = fm.m00 * cell_vertex[c0, 0] + fm.m01 * cell_vertex[c0, 1] + fm.t0
-        b0 = fm.m10 * cell_vertex[c0, 0] + fm.m11 * cell_vertex[c0, 1] + fm.t1
-        a1 = fm.m00 * cell_vertex[c0 + 1, 0] + fm.m01 * cell_vertex[c0 + 1, 1] + fm.t0
-        b1 = fm.m10 * cell_vertex[c0 + 1, 0] + fm.m11 * cell_vertex[c0 + 1, 1] + fm.t1
-        a2 = fm.m00 * cell_vertex[c0 + 2, 0] + fm.m01 * cell_vertex[c0 + 2, 1] + fm.t0
-        b2 = fm.m10 * cell_vertex[c0 + 2, 0] + fm.m11 * cell_vertex[c0 + 2, 1] + fm.t1
-        a3 = fm.m00 * cell_vertex[c0 + 3, 0] + fm.m01 * cell_vertex[c0 + 3, 1] + fm.t0
-        b3 = fm.m10 * cell_vertex[c0 + 3, 0] + fm.m11 * cell_vertex[c0 + 3, 1] + fm.t1
+        a0, b0, a1, b1, a2, b2, a3, b3 = _quad_to_target(cell_vertex, c0, fm)
         for li in range(l0, line_start[ft + 1]):
             if mask != ALL_LINES and not (mask >> (li - l0)) & 1:
                 continue
@@ -434,29 +445,6 @@ def cell_above(cell_start: np.ndarray, cell_vertex: np.ndarray, p: int, h0: floa
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _clip_step(
-    buf: np.ndarray, j: int, out: int, px: float, py: float, dp: float, cx: float, cy: float, dc: float
-) -> int:
-    """One edge (p -> c, signed distances dp, dc) of :func:`clip_halfplane`, written to buf[j]
-    from index ``out``; returns the new count (the same arithmetic, bit for bit)."""
-    if dc <= 0.0:
-        if dp > 0.0:
-            t = dp / (dp - dc)
-            buf[j, out, 0] = px + t * (cx - px)
-            buf[j, out, 1] = py + t * (cy - py)
-            out += 1
-        buf[j, out, 0] = cx
-        buf[j, out, 1] = cy
-        out += 1
-    elif dp <= 0.0:
-        t = dp / (dp - dc)
-        buf[j, out, 0] = px + t * (cx - px)
-        buf[j, out, 1] = py + t * (cy - py)
-        out += 1
-    return out
-
-
-@njit(cache=True, _nrt=False, inline="always")
 def _cut_quad(
     cell_start: np.ndarray, cell_vertex: np.ndarray, line: np.ndarray, li: int, buf: np.ndarray,
     nu: float, nw: float, point_area: float, touch_tol: float, p: int, fm: FaceMap, grow: float,
@@ -467,14 +455,7 @@ def _cut_quad(
     once and clipped unrolled. The same arithmetic in the same order, so the same answer bit for
     bit for finite input (tests/test_contacts.py checks it on random cells, maps and lines)."""
     c0 = cell_start[p]
-    a0 = fm.m00 * cell_vertex[c0, 0] + fm.m01 * cell_vertex[c0, 1] + fm.t0
-    b0 = fm.m10 * cell_vertex[c0, 0] + fm.m11 * cell_vertex[c0, 1] + fm.t1
-    a1 = fm.m00 * cell_vertex[c0 + 1, 0] + fm.m01 * cell_vertex[c0 + 1, 1] + fm.t0
-    b1 = fm.m10 * cell_vertex[c0 + 1, 0] + fm.m11 * cell_vertex[c0 + 1, 1] + fm.t1
-    a2 = fm.m00 * cell_vertex[c0 + 2, 0] + fm.m01 * cell_vertex[c0 + 2, 1] + fm.t0
-    b2 = fm.m10 * cell_vertex[c0 + 2, 0] + fm.m11 * cell_vertex[c0 + 2, 1] + fm.t1
-    a3 = fm.m00 * cell_vertex[c0 + 3, 0] + fm.m01 * cell_vertex[c0 + 3, 1] + fm.t0
-    b3 = fm.m10 * cell_vertex[c0 + 3, 0] + fm.m11 * cell_vertex[c0 + 3, 1] + fm.t1
+    a0, b0, a1, b1, a2, b2, a3, b3 = _quad_to_target(cell_vertex, c0, fm)
     lu = line[li, 0]
     lw = line[li, 1]
     lo = line[li, 2] + grow
@@ -489,10 +470,10 @@ def _cut_quad(
     xu = fm.m00 * nu + fm.m01 * nw + fm.t0
     xw = fm.m10 * nu + fm.m11 * nw + fm.t1
     node_in = not lu * xu + lw * xw - lo > INSIDE_TOL
-    n = _clip_step(buf, 1, 0, a3, b3, d3, a0, b0, d0)
-    n = _clip_step(buf, 1, n, a0, b0, d0, a1, b1, d1)
-    n = _clip_step(buf, 1, n, a1, b1, d1, a2, b2, d2)
-    n = _clip_step(buf, 1, n, a2, b2, d2, a3, b3, d3)
+    n = clip_edge(buf, 1, 0, a3, b3, d3, a0, b0, d0)
+    n = clip_edge(buf, 1, n, a0, b0, d0, a1, b1, d1)
+    n = clip_edge(buf, 1, n, a1, b1, d1, a2, b2, d2)
+    n = clip_edge(buf, 1, n, a2, b2, d2, a3, b3, d3)
     return _cover_tail(cell_start, cell_vertex, buf, 1, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area)
 
 

@@ -25,23 +25,32 @@ def clip_halfplane(buf: np.ndarray, i: int, n: int, lu: float, lw: float, lo: fl
         cx = buf[i, q, 0]
         cy = buf[i, q, 1]
         dc = lu * cx + lw * cy - lo
-        if dc <= 0.0:
-            if dp > 0.0:
-                t = dp / (dp - dc)
-                buf[j, out, 0] = px + t * (cx - px)
-                buf[j, out, 1] = py + t * (cy - py)
-                out += 1
-            buf[j, out, 0] = cx
-            buf[j, out, 1] = cy
-            out += 1
-        elif dp <= 0.0:
+        out = clip_edge(buf, j, out, px, py, dp, cx, cy, dc)
+        px = cx
+        py = cy
+        dp = dc
+    return out
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def clip_edge(buf: np.ndarray, j: int, out: int, px: float, py: float, dp: float, cx: float, cy: float, dc: float) -> int:
+    """One edge p -> c of :func:`clip_halfplane` (dp, dc: the two ends' signed distances
+    lu x + lw y - lo): what it adds to the clipped polygon in ``buf[j]`` from index ``out`` (the
+    crossing, then c if c is inside); returns the new count."""
+    if dc <= 0.0:
+        if dp > 0.0:
             t = dp / (dp - dc)
             buf[j, out, 0] = px + t * (cx - px)
             buf[j, out, 1] = py + t * (cy - py)
             out += 1
-        px = cx
-        py = cy
-        dp = dc
+        buf[j, out, 0] = cx
+        buf[j, out, 1] = cy
+        out += 1
+    elif dp <= 0.0:
+        t = dp / (dp - dc)
+        buf[j, out, 0] = px + t * (cx - px)
+        buf[j, out, 1] = py + t * (cy - py)
+        out += 1
     return out
 
 
