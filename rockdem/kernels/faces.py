@@ -147,6 +147,15 @@ def _quad_to_target(
     )
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _quad_distances(
+    a0: float, b0: float, a1: float, b1: float, a2: float, b2: float, a3: float, b3: float, lu: float, lw: float, lo: float,
+) -> tuple[float, float, float, float]:
+    """Signed distances lu u' + lw w' - lo of a quad's four vertices (u'_k, w'_k) = (a_k, b_k) from a
+    target edge line (> 0: outside; the arithmetic of :func:`rockdem.kernels.polygon.clip_halfplane`)."""
+    return lu * a0 + lw * b0 - lo, lu * a1 + lw * b1 - lo, lu * a2 + lw * b2 - lo, lu * a3 + lw * b3 - lo
+
+
 COVER_FULL = 1
 COVER_NONE = 0
 COVER_PART = -1
@@ -222,13 +231,8 @@ def covered(
         for li in range(l0, line_start[ft + 1]):
             if mask != ALL_LINES and not (mask >> (li - l0)) & 1:
                 continue
-            lu = line[li, 0]
-            lw = line[li, 1]
             lo = line[li, 2] + grow
-            d0 = lu * a0 + lw * b0 - lo
-            d1 = lu * a1 + lw * b1 - lo
-            d2 = lu * a2 + lw * b2 - lo
-            d3 = lu * a3 + lw * b3 - lo
+            d0, d1, d2, d3 = _quad_distances(a0, b0, a1, b1, a2, b2, a3, b3, line[li, 0], line[li, 1], lo)
             if max(max(d0, d1), max(d2, d3)) > INSIDE_TOL:
                 full = False
                 none = none or min(min(d0, d1), min(d2, d3)) >= -INSIDE_TOL
@@ -339,7 +343,9 @@ def partly_covered(
                 node_in = False
             n = clip_halfplane(buf, cur, n, lu, lw, lo)
             cur = 1 - cur
-    return _cover_tail(cell_start, cell_vertex, buf, cur, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area)
+    return _cover_tail(
+        cell_start, cell_vertex, buf, cur, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area,
+    )
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -459,10 +465,7 @@ def _cut_quad(
     lu = line[li, 0]
     lw = line[li, 1]
     lo = line[li, 2] + grow
-    d0 = lu * a0 + lw * b0 - lo
-    d1 = lu * a1 + lw * b1 - lo
-    d2 = lu * a2 + lw * b2 - lo
-    d3 = lu * a3 + lw * b3 - lo
+    d0, d1, d2, d3 = _quad_distances(a0, b0, a1, b1, a2, b2, a3, b3, lu, lw, lo)
     if not max(max(d0, d1), max(d2, d3)) > INSIDE_TOL:  # (the tests of covered())
         return point_area, nu, nw, 0.0, 0.0, nu, nw, nu, nw
     if min(min(d0, d1), min(d2, d3)) >= -INSIDE_TOL:
@@ -474,7 +477,9 @@ def _cut_quad(
     n = clip_edge(buf, 1, n, a0, b0, d0, a1, b1, d1)
     n = clip_edge(buf, 1, n, a1, b1, d1, a2, b2, d2)
     n = clip_edge(buf, 1, n, a2, b2, d2, a3, b3, d3)
-    return _cover_tail(cell_start, cell_vertex, buf, 1, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area)
+    return _cover_tail(
+        cell_start, cell_vertex, buf, 1, n, xu, xw, node_in, nu, nw, point_area, touch_tol, p, fm, lumped, target_cell_area,
+    )
 
 
 @njit(cache=True, _nrt=False)
@@ -500,7 +505,9 @@ def cut_cell(
         while not mask & 1:
             mask >>= 1
             li += 1
-        return _cut_quad(cell_start, cell_vertex, line, li, buf, nu, nw, point_area, touch_tol, p, fm, grow, lumped, target_cell_area)
+        return _cut_quad(
+            cell_start, cell_vertex, line, li, buf, nu, nw, point_area, touch_tol, p, fm, grow, lumped, target_cell_area,
+        )
     state = covered(cell_start, cell_vertex, line_start, line, p, ft, fm, grow, mask)
     if state == COVER_FULL:
         return point_area, nu, nw, 0.0, 0.0, nu, nw, nu, nw
