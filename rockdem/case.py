@@ -28,7 +28,7 @@ from ._warn import warn_user
 from .beta_choice import BETA_AUTO, BETA_MODES, BetaChoice
 from .geometry import MAX_FACE_POINTS, MAX_LENGTH
 from .materials import JointMaterial, check_material, ks_from_kn
-from .model import SETTLE_HINT, Damping, Model, ModelBuilder
+from .model import SETTLING, Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
 from .simulation import Monitor
 from .stopping import REST_WINDOW, STOP_MODES
@@ -711,27 +711,16 @@ def _chosen_damping(data: Mapping[str, Any], settled: bool = False) -> Iterator[
     alpha or beta itself (``beta = 0.0``: an undamped model by choice, e.g. the paper's
     discretised non-damped strategy, §3.2); without them it warns (model._warn_implausible_damping),
     and for a case that settles its blocks (``settled``: ``[run] settle``) without suggesting
-    settling (:data:`rockdem.model.SETTLE_HINT`): the block's warnings are then caught and issued
-    again as they leave it, that one without the hint under the caller's filters, the others as
-    they were (their own place)."""
+    settling (:data:`rockdem.model.SETTLING`)."""
     table = data.get("damping")
-    caught: list[warnings.WarningMessage] = []
+    token = SETTLING.set(settled)
     try:
-        with warnings.catch_warnings(record=settled) as seen:
-            if settled:
-                # caught whatever the caller's filters say (they apply when it is issued again)
-                warnings.filterwarnings("always", message="no damping", category=UserWarning)
-                caught = seen
+        with warnings.catch_warnings():
             if isinstance(table, Mapping) and ("beta" in table or "alpha" in table):
                 warnings.filterwarnings("ignore", message="no damping", category=UserWarning)
             yield
     finally:
-        for w in caught:
-            text = str(w.message)
-            if text.startswith("no damping"):
-                warn_user(text.replace(SETTLE_HINT, ""), w.category)
-            else:
-                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+        SETTLING.reset(token)
 
 
 _AUTO_KEYS = ("target_restitution", "per_interface", "release_fraction", "probe_impacts")

@@ -7,6 +7,7 @@ validates everything once and freezes it into a :class:`Model` of flat arrays
 
 from __future__ import annotations
 
+import contextvars
 import math
 from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Mapping, Sequence
@@ -980,8 +981,11 @@ OVERDAMPED_BETA = 10.0
 warned about (:func:`_warn_implausible_damping`; DeJong's beta, paper §2.2, is a critical one)."""
 
 SETTLE_HINT = ", or start from the blocks settled (a case's [run] settle = true)"
-"""The undamped-model warning's last suggestion, left out for a case that settles its blocks
-(:func:`rockdem.case._chosen_damping`)."""
+"""The undamped-model warning's last suggestion, left out while :data:`SETTLING` is true."""
+
+SETTLING: contextvars.ContextVar[bool] = contextvars.ContextVar("rockdem_settling", default=False)
+"""True while a case that settles its blocks (``[run] settle``) builds its model
+(:func:`rockdem.case._chosen_damping`): the undamped-model warning does not suggest settling."""
 
 
 UNDAMPED_HINT = 0.4
@@ -1050,7 +1054,7 @@ def _warn_implausible_damping(model: Model, damping: Damping) -> None:
             "decays; a block held by friction near its limit (on a slope, in a wedge) creeps at every cycle (1 mm/s "
             "on a 20 deg slope at a 30 deg friction angle) and sliding outruns Coulomb's law by up to 20 %; a small "
             f"SP damping removes both, e.g. damping.beta = {UNDAMPED_HINT * critical:.2g} s ({UNDAMPED_HINT:.0%} of "
-            f"critical on the slowest impact){SETTLE_HINT}")
+            f"critical on the slowest impact){'' if SETTLING.get() else SETTLE_HINT}")
         return
     if not beta > 0.0:
         return
