@@ -495,7 +495,9 @@ def _law_pairs(
 ) -> None:
     """:func:`_law_pair` for FACE pairs first..last - 1, in order (``buf`` as there), asking for the
     data of the pair :data:`PREFETCH_AHEAD` ahead as it goes. The joint law is compiled here once,
-    for the serial and the parallel pass alike."""
+    for the serial and the parallel pass alike; its callers hold copies of this code that Numba
+    optimized again inside them, slower on the 1000-brick wall, so a run loads this function's
+    own code first and every call runs it (:func:`rockdem.simulation._load_law_first`)."""
     for i in range(first, last):
         if i + PREFETCH_AHEAD < last:
             _prefetch_pair(m, s, sc, i + PREFETCH_AHEAD)
