@@ -96,24 +96,17 @@ def test_more_threads_than_numba_has_are_refused():
 
 _LAW_CODE_RUN = """
 import hashlib, sys, warnings
-warnings.simplefilter("error")  # the kernels' loading run (undamped) must not warn the user
 import numpy as np
 import rockdem.simulation as sim
-from rockdem.materials import JointMaterial
-from rockdem.model import Damping, ModelBuilder
+sys.path.insert(0, sys.argv[2])
+from test_parallel import _sp_stack
 if sys.argv[1] == "copy":
     sim._load_law_first = lambda model: None
-b = ModelBuilder(points=(2, 3))
-b.set_material("block", "block", JointMaterial(kn=1e9, friction_angle=35, cohesion=1e4, tension=1e4))
-b.set_material("block", "ground", JointMaterial(kn=1e9, friction_angle=35))
-b.set_material("ground", "ground", JointMaterial(kn=1e9))
-b.add_box(2.0, 2.0, 0.2, base_center=(0, 0, -0.2), driven=True, name="ground", group="ground")
-for k in range(3):
-    b.add_box(0.2, 0.5, 0.4, base_center=(0.02 * k, 0, 0.4 * k), density=2000, group="block", name=f"b{k}")
-b.tilt("b2", 0.9)
-ds = sim.simulate(b.finalize(damping=Damping(beta=0.002)), 0.5, record_interval=0.01, progress=False, threads=1)
+model = _sp_stack()
+warnings.simplefilter("error")  # the kernels' loading run (undamped) must not warn the user
+ds = sim.simulate(model, 0.5, record_interval=0.01, progress=False, threads=1)
 state = ds.block_position.values.tobytes() + ds.block_quaternion.values.tobytes()
-print(ds.attrs["steps"], np.ptp(ds.block_rotation.values[:, 3, :]), hashlib.sha256(state).hexdigest())
+print(ds.attrs["steps"], np.ptp(ds.block_rotation.values[:, model.block_id("b2"), :]), hashlib.sha256(state).hexdigest())
 """
 
 
@@ -126,7 +119,8 @@ def test_the_laws_own_code_and_the_copy_in_advance_give_the_same_answer():
 
     out = {}
     for which in ("own", "copy"):
-        run = subprocess.run([sys.executable, "-c", _LAW_CODE_RUN, which], capture_output=True, text=True, timeout=900)
+        run = subprocess.run([sys.executable, "-c", _LAW_CODE_RUN, which, str(Path(__file__).parent)], capture_output=True, text=True,
+                             timeout=900)
         assert run.returncode == 0, run.stderr[-2000:]
         out[which] = run.stdout.split()
     assert out["own"] == out["copy"]
