@@ -9,6 +9,7 @@ would grow into a visible one by the end.
 """
 
 import importlib.util
+import subprocess
 import sys
 from pathlib import Path
 
@@ -115,8 +116,6 @@ def test_the_laws_own_code_and_the_copy_in_advance_give_the_same_answer():
     (simulation._load_law_first: the copy inside a cached ``advance`` ran the 1000-brick wall 1.3
     times slower). Both compute the same answer bit for bit, and the loading is silent. Fresh
     processes: which code a call runs is settled when the kernels are first loaded."""
-    import subprocess
-
     out = {}
     for which in ("own", "copy"):
         run = subprocess.run([sys.executable, "-c", _LAW_CODE_RUN, which, str(Path(__file__).parent)], capture_output=True, text=True,
