@@ -62,19 +62,17 @@ def _laws(m, s, sc, dt, pairs, reps):  # type: ignore[no-untyped-def]
 
 
 @njit(_nrt=False)
-def _clipped_cells(m, s, sc, out):  # type: ignore[no-untyped-def]
-    """(pair, track index) of every sub-contact whose cell the law clips (faces.cut_cell), as
-    forces._law_range picks them (owner side: the wall's cut pairs do not blend); their count."""
+def _clipped_cells(m, s, sc, kind, out):  # type: ignore[no-untyped-def]
+    """(pair, track index, mask) of every sub-contact whose cell the law clips (faces.cut_cell),
+    as forces._law_range picks them (``kind``: the pairs' masks of _cover_kinds; owner side: the
+    wall's cut pairs do not blend); their count."""
     n = 0
     for i in range(s.pair_count[0]):
-        if s.pair_kind[i] == PAIR_EDGE:
+        mask = kind[i]
+        if mask == 0 or mask == RIGHT_ANGLES or mask == EDGE:
             continue
-        fo, ft = s.pair_owner_face[i], s.pair_target_face[i]
-        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
-        mask = -2 if abs(fm.det) < 1e-9 else crossing_lines(
-            m.face_corner_start, m.face_corner_uw, m.face_line_start, m.face_line, fo, ft, fm)
-        if mask == 0 or mask == -2:
-            continue
+        fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position,
+                             s.pair_owner_face[i], s.pair_target_face[i])
         for k in range(s.pair_track_start[i], s.pair_track_split[i]):
             p = s.track[k] // SLOTS
             j = s.track[k] - SLOTS * p
@@ -156,7 +154,7 @@ def main() -> None:
             line.append(f"{1e9 * (time.perf_counter() - t0) / 2000 / pairs.size:.0f} ({mean:.2f})")
         print(f"{name:>15}: " + ", ".join(line))
     cells = np.zeros((int(s.track_count[0]), 3), dtype=np.int64)
-    cells = cells[:_clipped_cells(m, s, start.scratch, cells)]
+    cells = cells[:_clipped_cells(m, s, start.scratch, kind, cells)]
     _clip_cells(m, s, start.scratch, cells, 1)  # compile
     best = np.inf
     for _ in range(3):

@@ -661,7 +661,6 @@ def _load_kernels(threads: int) -> None:
     array types, so one load serves them all."""
     if threads in _KERNELS_LOADED:
         return
-    first = not _KERNELS_LOADED
     _KERNELS_LOADED.add(threads)  # first: the run below would come here again
     from .materials import JointMaterial
     from .model import ModelBuilder
@@ -673,8 +672,7 @@ def _load_kernels(threads: int) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an undamped model is warned about
         model = b.finalize()
-        if first:
-            _load_law_first(model)
+        _load_law_first(model)
         run_model(model, 1e-3, record_interval=1e-3, progress=False, threads=threads)
 
 
@@ -688,7 +686,7 @@ def _load_law_first(model: Model) -> None:
     weak symbols). Compiled on an empty cache, the callee's own code comes first; loaded from the
     cache, the copy inside ``advance`` did, and the 1000-brick wall's step took 1.3 to 1.5 times as
     long (2026-11-30: 1.97 against 1.39 ms, the same process, the same answers). A call over no
-    pairs loads it and computes nothing."""
+    pairs loads it and computes nothing (after the first, it only finds it loaded)."""
     from .kernels.forces import _law_pairs
     from .state import _allocate
 
