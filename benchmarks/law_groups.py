@@ -18,6 +18,13 @@ A third line gives the clipping alone (``faces.cut_cell``, compiled out of line 
 it) per cell that the law clips, in cache, 200 passes, with the face map computed as the law
 does: a measure of the clipping that the law's compiled loop does not blur
 (docs/performance.md, "twelfth session").
+
+A last line gives a floor for the flush joints: the arithmetic of a bonded, wholly covered,
+elastic sub-contact (``_lean_flush``: overlap, point, relative velocity, shear carried and
+incremented, limits tested, springs' forces and energy, the pair's resultant; the face map per
+pair), without the general law's branches and bookkeeping, on the same pairs and state layout.
+It is a measure, not a law: it falls back to nothing when a limit is reached (docs/performance.md,
+"fifteenth session").
 """
 
 from __future__ import annotations
@@ -33,8 +40,9 @@ from numba import njit
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_engine import wall_model  # noqa: E402
 
+from rockdem.kernels.contact import coulomb_limit, shear_increment  # noqa: E402
 from rockdem.kernels.faces import cell_above, crossing_lines, cut_cell, face_map_arrays  # noqa: E402
-from rockdem.kernels.forces import _law_pair  # noqa: E402
+from rockdem.kernels.forces import _law_pair, _relative_velocity_arrays  # noqa: E402
 from rockdem.kernels.layout import PAIR_EDGE, SLOTS  # noqa: E402
 from rockdem.simulation import prepare_start, run_model  # noqa: E402
 
@@ -105,6 +113,57 @@ def _clip_cells(m, s, sc, cells, reps):  # type: ignore[no-untyped-def]
     return total
 
 
+@njit(_nrt=False)
+def _lean_flush(m, s, sc, dt, pairs, reps):  # type: ignore[no-untyped-def]
+    """The floor of the flush joints' law (module notes); returns how many sub-contacts passed
+    their limits (all of them on a settled wall)."""
+    passed = 0
+    for _ in range(reps):
+        for i in pairs:
+            fo, ft = s.pair_owner_face[i], s.pair_target_face[i]
+            o, t = m.face_block[fo], m.face_block[ft]
+            g0, g1 = m.block_group[o], m.block_group[t]
+            kn, ks, tension = m.mat_kn[g0, g1], m.mat_ks[g0, g1], m.mat_tension[g0, g1]
+            cohesion, tan_friction = m.mat_cohesion[g0, g1], m.mat_tan_friction[g0, g1]
+            fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
+            n0, n1, n2 = fm.nx, fm.ny, fm.nz
+            sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = energy = 0.0
+            for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
+                p = s.track[k] // SLOTS
+                j = s.track[k] - SLOTS * p
+                area, yu, yw = m.point_area[p], m.point_node[p, 0], m.point_node[p, 1]
+                un = -(fm.h0 + fm.hu * yu + fm.hw * yw) - s.slot_set[p, j]
+                x0 = fm.ox + yu * fm.eux + yw * fm.ewx + 0.5 * un * n0
+                x1 = fm.oy + yu * fm.euy + yw * fm.ewy + 0.5 * un * n1
+                x2 = fm.oz + yu * fm.euz + yw * fm.ewz + 0.5 * un * n2
+                v0, v1, v2 = _relative_velocity_arrays(s.position, s.velocity, sc.omega_world, o, t, x0, x1, x2)
+                vn = v0 * n0 + v1 * n1 + v2 * n2
+                ksa = ks * area
+                fn = kn * area * un
+                us0, us1, us2, _, _, _ = shear_increment(s.slot_shear[p, j, 0], s.slot_shear[p, j, 1], s.slot_shear[p, j, 2],
+                                                         n0, n1, n2, v0 - vn * n0, v1 - vn * n1, v2 - vn * n2, dt)
+                fmax = coulomb_limit(cohesion, tan_friction, area, fn)
+                passed += s.slot_bonded[p, j] and fn >= -tension * area and ksa * ksa * (us0 * us0 + us1 * us1 + us2 * us2) <= fmax * fmax
+                s.slot_overlap[p, j] = un
+                s.slot_shear[p, j, 0] = us0
+                s.slot_shear[p, j, 1] = us1
+                s.slot_shear[p, j, 2] = us2
+                s.slot_normal_force[p, j] = fn
+                energy += 0.5 * (fn * un + ksa * (us0 * us0 + us1 * us1 + us2 * us2))
+                f0, f1, f2 = fn * n0 + ksa * us0, fn * n1 + ksa * us1, fn * n2 + ksa * us2
+                r0, r1, r2 = x0 - s.position[o, 0], x1 - s.position[o, 1], x2 - s.position[o, 2]
+                sf0 += f0
+                sf1 += f1
+                sf2 += f2
+                sm0 += r1 * f2 - r2 * f1
+                sm1 += r2 * f0 - r0 * f2
+                sm2 += r0 * f1 - r1 * f0
+            sc.side_force[i, 0, 0], sc.side_force[i, 0, 1], sc.side_force[i, 0, 2] = sf0, sf1, sf2
+            sc.side_moment[i, 0, 0], sc.side_moment[i, 0, 1], sc.side_moment[i, 0, 2] = sm0, sm1, sm2
+            sc.side_elastic[i, 0] = energy
+    return passed
+
+
 def main() -> None:
     numba.set_num_threads(1)
     model = wall_model()
@@ -163,6 +222,24 @@ def main() -> None:
         best = min(best, (time.perf_counter() - t0) / 200)
     print(f"clipping alone (faces.cut_cell, face map included), in cache: {len(cells)} cells, "
           f"{1e9 * best / max(len(cells), 1):.0f} ns per cell")
+    flush = groups["flush"]
+    bonded = flush[[bool(start.scratch.pair_bonded[i]) for i in flush]]
+    count = int(per_pair[bonded].sum())
+    if count:
+        _lean_flush(m, start.copy().state, start.scratch, dt, bonded, 1)  # compile
+        general = lean = np.inf
+        for _ in range(3):  # alternating
+            copy = start.copy()
+            t0 = time.perf_counter()
+            _laws(m, copy.state, copy.scratch, dt, bonded, 100)
+            general = min(general, (time.perf_counter() - t0) / 100)
+            copy = start.copy()
+            t0 = time.perf_counter()
+            passed = _lean_flush(m, copy.state, copy.scratch, dt, bonded, 100)
+            lean = min(lean, (time.perf_counter() - t0) / 100)
+        print(f"bonded flush joints, {bonded.size} pairs, {count} sub-contacts: the law {1e9 * general / count:.1f}, "
+              f"its arithmetic alone {1e9 * lean / count:.1f} ns per sub-contact (face map included; "
+              f"{passed / 100 / count:.0%} within their limits)")
 
 
 if __name__ == "__main__":
