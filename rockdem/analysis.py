@@ -756,19 +756,19 @@ def is_free_rocking(ds: Any) -> bool:
     return free_rocking_run(ds.attrs, released=bool(np.any(ds.rocking_angle.values[0, free] != 0.0)), ground_moved=moved)
 
 
-def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = None) -> dict[str, Any]:
+def summarize_result(ds: Any, block: int | str | None = None, *, eta: float | None = None) -> dict[str, Any]:
     """:func:`summarize` for one block of a rockdem result (``xarray.Dataset``).
 
     Args:
         ds: result with ``time``, ``rocking_angle (time, block)`` [rad] and ``block_free (block)``;
             optional ``block_eta (block)`` [rad] and the geometry used by
             :func:`lowest_point_height` (for bouncing).
-        block: block index; default the first free block.
+        block: block index or name; default the first free block.
         eta: slenderness angle [rad]; default :func:`result_eta` (the assembly's angle for a
             released assembly, else ``block_eta[block]``), else no e_a and no overturning flag.
 
     Raises:
-        ValueError: missing variables, no free block, or a bad block index.
+        ValueError: missing variables, no free block, or a bad block index or name.
     """
     for name in ("time", "rocking_angle", "block_free"):
         if name not in ds.variables:
@@ -779,8 +779,14 @@ def summarize_result(ds: Any, block: int | None = None, *, eta: float | None = N
         if len(idx) == 0:
             raise ValueError("result has no free block to summarize")
         block = int(idx[0])
-    if not (0 <= block < len(free)):
-        raise ValueError(f"block index {block} out of range 0..{len(free) - 1}")
+    elif isinstance(block, str):
+        names = [str(n) for n in ds["block_name"].values] if "block_name" in ds.variables else []
+        if block not in names:
+            raise ValueError(f"block {block!r} not in the result; give one of {names[:10]}{' ...' if len(names) > 10 else ''}")
+        block = names.index(block)
+    if isinstance(block, bool) or not isinstance(block, (int, np.integer)) or not (0 <= block < len(free)):
+        raise ValueError(f"block index {block!r} out of range 0..{len(free) - 1} (or give a block's name)")
+    block = int(block)
     if eta is None:
         eta = result_eta(ds, block)
     t = np.asarray(ds["time"].values, dtype=float)

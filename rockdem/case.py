@@ -11,6 +11,8 @@ from __future__ import annotations
 import contextlib
 import copy
 import dataclasses
+import difflib
+import importlib.util
 import json
 import math
 import os
@@ -86,11 +88,18 @@ class Table:
         self.used.add(key)
         return self.data.get(key, default)
 
+    def _required(self, key: str, what: str) -> ValueError:
+        """The error for a required ``key`` that is absent, naming a key of the table that looks
+        like a misspelling of it (``widht`` for ``width``)."""
+        near = difflib.get_close_matches(key, [k for k in self.data if k not in self.used], n=1, cutoff=0.7)
+        hint = f"; the table has {near[0]!r}: a misspelling of {key!r}?" if near else ""
+        return ValueError(f"[{self.where}] {key} is required ({what}){hint}")
+
     def number(self, key: str, default: float | None = None, *, positive: bool = False, min_: float | None = None) -> float:
         """A real number; ``default=None`` makes it required."""
         v = self._get(key, default)
         if v is None:
-            raise ValueError(f"[{self.where}] {key} is required (a number)")
+            raise self._required(key, "a number")
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"[{self.where}] {key} must be a finite number, got {v!r}")
         check_plausible(v, f"[{self.where}] {key}", key)
@@ -111,7 +120,7 @@ class Table:
         """An integer in [min_, max_]; ``default=None`` makes it required."""
         v = self._get(key, default)
         if v is None:
-            raise ValueError(f"[{self.where}] {key} is required (an integer)")
+            raise self._required(key, "an integer")
         if isinstance(v, bool) or not isinstance(v, int):
             raise ValueError(f"[{self.where}] {key} must be an integer, got {v!r}")
         if v < min_:
@@ -123,13 +132,16 @@ class Table:
     def points(self, across: int = 2, along: int = 2) -> tuple[int, int]:
         """Interface points per face from ``points_across`` and ``points_along`` (at most
         :data:`~rockdem.geometry.MAX_FACE_POINTS` per face)."""
-        a = self.integer("points_across", across, min_=1, max_=MAX_FACE_POINTS)
-        b = self.integer("points_along", along, min_=1, max_=MAX_FACE_POINTS)
+        a = self.integer("points_across", across, min_=-MAX_FACE_POINTS, max_=MAX_FACE_POINTS)
+        b = self.integer("points_along", along, min_=-MAX_FACE_POINTS, max_=MAX_FACE_POINTS)
         for key, n in (("points_across", a), ("points_along", b)):
-            if n < 2:
+            if n == 1:
                 raise ValueError(
                     f"[{self.where}] {key} = 1 puts a face's only point at its middle: a block on it balances on a "
                     "knife edge and cannot rock about its edges; give 2 or more (the paper uses 2 to 15)")
+            if n < 2:
+                raise ValueError(f"[{self.where}] {key} must be 2 or more (points across a face, with its edges; "
+                                 f"the paper uses 2 to 15), got {n}")
         if a * b > MAX_FACE_POINTS:
             raise ValueError(
                 f"[{self.where}] points_across x points_along = {a} x {b} exceeds the limit of {MAX_FACE_POINTS} "
@@ -146,7 +158,7 @@ class Table:
     def string(self, key: str, default: str | None = None, *, choices: tuple[str, ...] | None = None) -> str:
         v = self._get(key, default)
         if v is None:
-            raise ValueError(f"[{self.where}] {key} is required (a string)")
+            raise self._required(key, "a string")
         if not isinstance(v, str):
             raise ValueError(f"[{self.where}] {key} must be a string, got {v!r}")
         if choices is not None and v not in choices:
@@ -156,7 +168,7 @@ class Table:
     def vector(self, key: str, default: tuple[float, ...] | None = None, *, size: int = 3) -> np.ndarray:
         v = self._get(key, default)
         if v is None:
-            raise ValueError(f"[{self.where}] {key} is required (a list of {size} numbers)")
+            raise self._required(key, f"a list of {size} numbers")
         arr = self._numbers(key, v, f"a list of {size} numbers")
         if arr.shape != (size,):
             raise ValueError(f"[{self.where}] {key} must be a list of {size} numbers, got {v!r}")
@@ -167,7 +179,7 @@ class Table:
         v = self._get(key, None)
         what = "a non-empty list of " + ("positive " if positive else "") + "numbers"
         if v is None:
-            raise ValueError(f"[{self.where}] {key} is required ({what})")
+            raise self._required(key, what)
         arr = self._numbers(key, v, what)
         if arr.size == 0:
             raise ValueError(f"[{self.where}] {key} must be {what}, got {v!r}")
@@ -596,7 +608,21 @@ def _output(top: Table) -> dict[str, Any]:
         "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
+    if output["contacts"] == "parquet" and importlib.util.find_spec("pyarrow") is None:
+        raise ValueError('[output] contacts = "parquet" needs pyarrow (pip install pyarrow); or give contacts = "csv" '
+                         '("auto" writes Parquet when pyarrow is installed, else CSV)')
     return output
+
+
+def _case_name(top: Table) -> str:
+    """``name``: the case's title, and the name of its output folder (``results/<name>``) when no
+    folder is given, so a plain name (no path)."""
+    name = top.string("name", "case")
+    if not name.strip() or name.strip() in (".", "..") or any(c in name for c in "/\\\0"):
+        raise ValueError(f"[case] name = {name!r}: the name titles the run and names its output folder (results/<name>); "
+                         "give a plain, non-empty name without '/', '\\' or '..' (choose another folder with "
+                         "--out or [output] directory)")
+    return name
 
 
 def parse_case(data: Mapping[str, Any]) -> Case:
@@ -643,7 +669,7 @@ class CaseTemplate:
     def __init__(self, data: Mapping[str, Any]) -> None:
         top = Table(data, "case")
         self.key = template_key(data)
-        name = top.string("name", "case")
+        name = _case_name(top)
         top.string("description", "")
         run = _run_options(top)
         damping = _damping(top.sub("damping"))
@@ -682,7 +708,7 @@ class CaseTemplate:
         top = Table(data, "case")
         if template_key(data) != self.key:
             raise ValueError("CaseTemplate.derive: the case's specimen or loading differs from the template's")
-        name = top.string("name", "case")
+        name = _case_name(top)
         top.string("description", "")
         run = _run_options(top)
         damping = _damping(top.sub("damping"))

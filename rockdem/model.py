@@ -21,7 +21,7 @@ from .flatten import BlockFrame, flatten_geometry
 from .geometry import MAX_FACE_POINTS, Polyhedron, box, mass_properties
 from .kernels.layout import ModelArrays
 from .kernels.rotation import axis_angle_matrix, matrix_to_quat
-from .materials import (HEAVIEST_DENSITY, PLAUSIBLE_DENSITY, PLAUSIBLE_FRICTION_ANGLE, PLAUSIBLE_MODULUS, JointMaterial,
+from .materials import (HEAVIEST_DENSITY, PLAUSIBLE_DENSITY, PLAUSIBLE_FRICTION_ANGLE, PLAUSIBLE_MODULUS, STIFFEST_MODULUS, JointMaterial,
                         real_number)
 
 __all__ = ["Motion", "Damping", "ModelBuilder", "Model", "GROUND"]
@@ -387,6 +387,15 @@ class ModelBuilder:
         self.ground_motion: Motion | None = None
         self.body_acceleration: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
         self._release: Release | None = None
+        self._load_direction: NDArray[np.float64] | None = None
+
+    def load_along(self, direction: ArrayLike) -> None:
+        """Record the horizontal direction [-] (3,) of the model's loading (an earthquake, a
+        pushover: :mod:`rockdem.loading` calls this), so that :meth:`finalize` takes up x d as its
+        default rocking axis and ``rocking_angle`` tips blocks along the load (before 2026-11-30 an
+        earthquake along y was measured about y: a block it overturned read 0 rad, "not overturned").
+        A later :meth:`tilt` takes the axis back."""
+        self._load_direction = self._horizontal(_vector3(direction, "loading direction"))
 
     @property
     def release(self) -> Release | None:
@@ -556,13 +565,17 @@ class ModelBuilder:
         d = _vector3(direction, "tilt direction")
         geo = self._tilt(ids, fraction, d)
         self._release = Release(tuple(b.name for b in blocks), float(fraction), self._horizontal(d))
+        self._load_direction = None
         return geo.angle
 
     def default_rocking_axis(self) -> NDArray[np.float64]:
         """(3,) the rocking axis :meth:`finalize` takes by default: the line the last :meth:`tilt`
         turned the blocks about, oriented along +y where it has a y component, else along -x (so
         that a positive ``rocking_angle`` tips towards +x, or towards +y for rocking in y-z,
-        whichever way the tilt went); y without a tilt."""
+        whichever way the tilt went); y without a tilt. After a loading along d (:meth:`load_along`)
+        up x d, so that a positive angle tips blocks along the load."""
+        if self._load_direction is not None:
+            return np.cross(self._up(), self._load_direction) + 0.0
         if self._release is None:
             return np.array([0.0, 1.0, 0.0])
         turn = np.cross(self._up(), self._release.direction)
@@ -730,6 +743,9 @@ class ModelBuilder:
         damping.validate()
         if not any(b.driven is False for b in self._blocks):
             raise ValueError("the model has no free block: every block is driven")
+        if all(b.driven is False for b in self._blocks) and np.any(self.gravity):
+            warn_user("the model has no driven block: nothing supports its free blocks, which fall freely under gravity "
+                      "from t = 0; add a foundation (add_box(..., driven=True))")
         groups = sorted({b.group for b in self._blocks})
         gi = {g: k for k, g in enumerate(groups)}
         ng = len(groups)
@@ -1099,5 +1115,12 @@ def _warn_implausible_units(blocks: Sequence, mats: dict[tuple[str, str], JointM
             warn_user(
                 f"joint {ga!r}-{gb!r}: kn = {mat.kn:g} N/m^3 implies a youngs_modulus of about kn x {size:g} m = "
                 f"{modulus:g} Pa, below 1 MPa; moduli are in Pa (1.8 GPa is 1.8e9), not MPa")
+            break
+        if modulus > STIFFEST_MODULUS:
+            warn_user(
+                f"joint {ga!r}-{gb!r}: kn = {mat.kn:g} N/m^3 implies a youngs_modulus of about kn x {size:g} m = "
+                f"{modulus:g} Pa, stiffer than any material (steel 2e11 Pa, masonry 1e9 to 1e10); its overlaps come "
+                "near the round-off of the blocks' positions, and a run may stop for energy created at rest; check "
+                "its units (Pa/m)")
             break
 

@@ -100,6 +100,10 @@ RESULT_VARIABLES = ("block_free", "block_name", "block_position", "rocking_angle
 """Variables every result of rockdem run or simulate holds (the commands check for them)."""
 
 
+NETCDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05", b"\x89HDF\r\n\x1a\n")
+"""The first bytes of a NetCDF file: classic, 64-bit offset and CDF-5 formats, and NetCDF-4 (HDF5)."""
+
+
 def input_file(path: str | Path, what: str, give: str) -> Path:
     """``path`` as a Path once it is an existing regular file; else FileNotFoundError or ValueError
     naming it as ``what`` and saying what to ``give``."""
@@ -115,6 +119,12 @@ def read_result_file(path: str | Path, what: str = "result file") -> xr.Dataset:
     """A rockdem result read from ``path`` for a command: FileNotFoundError or ValueError naming the
     file (as ``what``) when it is missing, not a regular file, not a result or holds no frame."""
     p = input_file(path, what, "the result.nc written by rockdem run (OUT/result.nc)")
+    with open(p, "rb") as f:
+        head = f.read(8)
+    if not head.startswith(NETCDF_SIGNATURES):
+        kind = " (a checkpoint: continue it with rockdem run CASE --from it)" if head.startswith(b"PK") else ""
+        raise ValueError(f"{what} {p} is not a rockdem result: not a NetCDF file{kind}; give the result.nc written by "
+                         "rockdem run (OUT/result.nc)")
     try:
         ds = load_result(p)
     except (ValueError, OSError, KeyError) as exc:

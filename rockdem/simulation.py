@@ -458,6 +458,11 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         info = stable_timestep(model, rule=rule or "bound", safety=safety, resolution=resolution, dt=dt,
                                dashpots=dashpots)
     _check_step_count(info, duration, max_steps)
+    if interval * FRAMES_PER_STEP < info.dt:
+        raise ValueError(f"record_interval = {interval:g} s puts {info.dt / interval:.3g} frames in each time step "
+                         f"({info.dt:.4g} s), all interpolated between the same two steps (more than {FRAMES_PER_STEP}); "
+                         f"give record_interval >= {info.dt / FRAMES_PER_STEP:.3g} s, or the step itself")
+    _check_motions(model, info.dt, duration)
     rec = _frames(model, duration, interval)
     if start is not None:
         state, scratch = start.state, start.scratch
@@ -476,6 +481,54 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
     scratch.energy_scale[0] = LIFT_1MM * float(m.block_mass[m.block_free].sum())  # lifting the free blocks by 1 mm
     snaps.take(state)
     return _Run(info, state, scratch, rec, 0, interval, snaps)
+
+
+FRAMES_PER_STEP = 100
+"""Most frames a run may record within one time step: each lies on the leapfrog path between the
+same two steps, so a record_interval far below the step only multiplies the output (1e-7 s wrote 5
+million frames, 1.9 GB, from 709 steps) and is refused."""
+
+MOTION_MISSED = 0.05
+"""Largest share of a driven block's prescribed path [m] that the first time step may miss
+(:func:`_check_motions`)."""
+
+MOTION_CHECK_STEPS = 10**6
+"""Motions longer than this many first steps are not checked (their samples are far apart
+against the step: a recorded ground motion under a stiff model)."""
+
+
+def _check_motions(model: Model, dt: float, duration: float) -> None:
+    """Refuse a prescribed motion that changes faster than the step ``dt`` [s] resolves: a driven
+    block moves by its velocity at the middle of each step (kernels.step), so a push over a
+    fraction of a step is missed (a pushover rod at 1e4 m/s stayed where it was and the run
+    reported success). Compares that sum with the motion's exact integral up to ``duration``."""
+    m = model.arrays
+    for k in range(m.motion_start.shape[0] - 1):
+        t = m.motion_time[m.motion_start[k]:m.motion_start[k + 1]]
+        v = m.motion_velocity[m.motion_start[k]:m.motion_start[k + 1]]
+        end = min(float(t[-1]), duration)
+        steps = math.ceil(end / dt)
+        if end <= 0.0 or steps > MOTION_CHECK_STEPS:
+            continue
+        inside = (t > 0.0) & (t < end)
+        tk = np.r_[0.0, t[inside], end]
+        vk = np.vstack([[np.interp(0.0, t, v[:, i]) for i in range(3)], v[inside], [np.interp(end, t, v[:, i]) for i in range(3)]])
+        h = np.diff(tk)[:, None]
+        speed = np.linalg.norm(vk, axis=1)[:, None]
+        path = float(np.sum(0.5 * h * (speed[1:] + speed[:-1])))  # trapezoid rules: v is linear between samples
+        if path == 0.0:
+            continue
+        exact = np.sum(0.5 * h * (vk[1:] + vk[:-1]), axis=0)
+        mid = (np.arange(steps) + 0.5) * dt
+        width = np.minimum(dt, end - np.arange(steps) * dt)  # the last step ends at ``end``
+        stepped = np.array([np.sum(np.interp(mid, t, v[:, i]) * width) for i in range(3)])
+        missed = float(np.linalg.norm(stepped - exact))
+        if missed > MOTION_MISSED * path:
+            names = [n for n, mo in zip(model.block_names, m.block_motion) if mo == k]
+            raise ValueError(
+                f"driven block(s) {names}: the time step ({dt:.3g} s) misses {missed / path:.0%} of their prescribed "
+                f"motion ({path:.3g} m of path over {end:.3g} s), which changes faster than a step; make the "
+                "motion slower (a pushover's velocity) or give a smaller time step (dt)")
 
 
 REST_SHARE = 1e-3

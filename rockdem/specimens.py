@@ -25,6 +25,7 @@ from .geometry import MAX_LENGTH, Polyhedron, box, convex_hull, mass_properties
 from .kernels.rotation import axis_angle_matrix
 from .materials import JointMaterial, real_number
 from .model import GROUND, Motion, ModelBuilder
+from .records import STANDARD_GRAVITY
 from .simulation import Monitor
 
 __all__ = [
@@ -444,6 +445,11 @@ def parapet(
 
 
 # -- one-sided façade -------------------------------------------------------------------------------
+ROCKING_SPEED_LIMIT = 10.0
+"""A façade's initial ``rocking_velocity`` that moves its top faster than this many times the speed
+of a fall from its height is refused (1e6 rad/s ran 46 million steps before leaving the model)."""
+
+
 def facade(
     builder: ModelBuilder,
     *,
@@ -529,6 +535,11 @@ def facade(
     if isinstance(slope_deg, bool) or not isinstance(slope_deg, (int, float)) or not abs(slope_deg) < 45:
         raise ValueError(f"slope_deg must be an angle in (-45, 45) degrees, got {slope_deg!r}")
     real_number(rocking_velocity, "rocking_velocity [rad/s]")
+    fall = math.sqrt(2.0 * STANDARD_GRAVITY * h)  # the speed of a fall from the façade's height
+    if abs(rocking_velocity) * h > ROCKING_SPEED_LIMIT * fall:
+        raise ValueError(f"rocking_velocity = {rocking_velocity:g} rad/s moves the façade's top at {abs(rocking_velocity) * h:.3g} "
+                         f"m/s, more than {ROCKING_SPEED_LIMIT:g} times the speed of a fall from its height ({fall:.3g} m/s); "
+                         "check the value (rad/s, not deg/s)")
     material = _material("material", material)
     return_material = _material("return_material", return_material)
     if brick is not None:
@@ -733,6 +744,16 @@ def _sub_material(t: Table, key: str, *, spacing: float) -> JointMaterial | None
     return mat
 
 
+def _brick_key(t: Table, default: tuple[float, ...] | None, labels: tuple[str, ...]) -> tuple[float, ...]:
+    """``brick``, a list of positive lengths [m] named by ``labels`` (checked before the joint
+    material, whose kn = E / l may take l from it)."""
+    brick = tuple(float(v) for v in t.vector("brick", default, size=len(labels)))
+    for i, (v, label) in enumerate(zip(brick, labels)):
+        if not v > 0.0:
+            raise ValueError(f"[{t.where}] brick[{i}] ({label}) must be a positive length [m], got {v:g}")
+    return brick
+
+
 @specimen("stack")
 def _stack_case(t: Table, b: ModelBuilder) -> Monitors:
     """Stacked blocks. Keys: width, length, heights (list) [m], density, points_across,
@@ -755,9 +776,9 @@ def _wall_case(t: Table, b: ModelBuilder) -> Monitors:
     points_across, points_along, base_reduction [m], foundation_extent [m] (plan size of the
     foundation; default sized for collapse), [joint] (bed/head joints, kn = E / lz) and optional
     [base] (base joint; default the joint's)."""
-    brick = t.vector("brick", (0.11, 0.23, 0.076))
+    brick = _brick_key(t, (0.11, 0.23, 0.076), ("thickness, x", "length, y", "height, z"))
     kw = dict(
-        brick=tuple(float(v) for v in brick),
+        brick=brick,
         courses=t.integer("courses", min_=1),
         bricks_per_course=t.integer("bricks_per_course", min_=1),
         bond=t.string("bond", "running", choices=BONDS),
@@ -783,7 +804,7 @@ def _parapet_case(t: Table, b: ModelBuilder) -> Monitors:
     thickness = t.number("thickness", 0.23, positive=True)
     height = t.number("height", positive=True)
     length = t.number("length", 1.0, positive=True)
-    brick = tuple(float(v) for v in t.vector("brick", size=2)) if "brick" in t.data else None
+    brick = _brick_key(t, None, ("length, y", "height, z")) if "brick" in t.data else None
     t.used.add("brick")
     bond = t.string("bond", "running", choices=BONDS)
     pts = t.points(2, 3 if brick is not None else 2)
@@ -813,7 +834,7 @@ def _facade_case(t: Table, b: ModelBuilder) -> Monitors:
     foundation_extent [m] (plan size of the foundation; default sized for collapse), the joint keys (kn = E / height, or E / course height when discretised) and optional [return]
     (façade-return wall contact)."""
     height = t.number("height", 0.8, positive=True)
-    brick = tuple(float(v) for v in t.vector("brick", size=2)) if "brick" in t.data else None
+    brick = _brick_key(t, None, ("length, y", "height, z")) if "brick" in t.data else None
     t.used.add("brick")
     spacing = height if brick is None else height / max(1, round(height / brick[1]))
     mat = joint_material(t, spacing=spacing)

@@ -390,7 +390,7 @@ def test_killed_sweep_leaves_no_worker_running(tmp_path, sig):
 
 
 def test_a_sweep_names_why_its_failed_runs_failed(tmp_path, capsys):
-    """A grid whose second row fails when it runs (a record interval whose frames would take 2 TB)
+    """A grid whose second row fails when it runs (a record interval of a billion frames per step)
     runs the first and prints the second's error on the console, not only a count (before
     2026-11-29: "2 runs (1 failed, 0 diverged)", the reason only in table.csv). A second row that is
     no valid case is refused before any run, naming it (it failed at its turn)."""
@@ -402,7 +402,7 @@ def test_a_sweep_names_why_its_failed_runs_failed(tmp_path, capsys):
     assert main(["sweep", str(f), "--out", str(tmp_path / "o"), "--no-progress"]) == 1
     captured = capsys.readouterr()
     assert "2 runs (1 failed, 0 diverged)" in captured.out
-    assert "failed: ValueError: recording 10000000001 frames" in captured.err
+    assert "failed: ValueError: record_interval = 1e-12 s puts 7.06e+08 frames in each time step" in captured.err
     f.write_text('[study]\nbase = "free-rocking"\nduration = 0.01\nexecutor = "serial"\n'
                  '[study.grid]\n"specimen.width" = [0.2, -1.0]\n')
     assert main(["sweep", str(f), "--out", str(tmp_path / "o2"), "--no-progress"]) == 2

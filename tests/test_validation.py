@@ -188,7 +188,8 @@ def test_missing_material_and_no_free_block():
         (("specimen", "width", -0.2), r"\[specimen\] width must be positive"),
         (("specimen", "type", "pyramid"), r"\[specimen\] type must be one of"),
         (("damping", "beta", "big"), r"\[damping\] beta must be a finite number"),
-        (("specimen", "points_across", 0), r"\[specimen\] points_across must be >= 1"),
+        (("specimen", "points_across", 0), r"\[specimen\] points_across must be 2 or more .* got 0"),
+        (("specimen", "points_along", -3), r"\[specimen\] points_along must be 2 or more .* got -3"),
         (("specimen", "points_across", 1), r"\[specimen\] points_across = 1 .* knife edge"),
         (("specimen", "points_along", 1), r"\[specimen\] points_along = 1 .* give 2 or more"),
         (("specimen", "kn", 1e9), r"give exactly one of kn"),
@@ -570,3 +571,161 @@ def test_an_empty_override_removes_a_key_and_only_an_existing_one():
     assert data["loading"]["scale"] == 2.0  # the case itself is left alone
     with pytest.raises(ValueError, match="an empty value removes a key, and the case has no loading.tail"):
         apply_overrides(data, ["loading.tail="])
+
+
+# -- what a new user's hostile cases found (2026-11-30)
+def test_a_misspelt_required_key_is_named_with_the_required_one():
+    data = example_case("free-rocking")
+    data["specimen"]["widht"] = data["specimen"].pop("width")
+    with pytest.raises(ValueError, match=r"\[specimen\] width is required \(a number\); the table has 'widht': a misspelling"):
+        parse_case(data)
+    del data["specimen"]["widht"]  # nothing like it: the plain message
+    with pytest.raises(ValueError, match=r"\[specimen\] width is required \(a number\)$"):
+        parse_case(data)
+
+
+@pytest.mark.parametrize("name", ["../../escape", "/tmp/absolute", "", "  ", "..", "a\\b"])
+def test_a_case_name_that_is_not_a_plain_folder_name_is_refused(name):
+    data = example_case("free-rocking")
+    data["name"] = name
+    with pytest.raises(ValueError, match=r"\[case\] name = .* names its output folder"):
+        parse_case(data)
+
+
+@pytest.mark.parametrize("specimen, brick, message", [
+    ({"type": "wall", "courses": 2, "bricks_per_course": 2, "joint": {"youngs_modulus": 1e9}},
+     [0.1, 0.2, -0.076], r"brick\[2\] \(height, z\) must be a positive length"),
+    ({"type": "wall", "courses": 2, "bricks_per_course": 2, "joint": {"youngs_modulus": 1e9}},
+     [0.1, 0.0, 0.076], r"brick\[1\] \(length, y\) must be a positive length"),
+    ({"type": "parapet", "height": 0.6, "youngs_modulus": 1e9}, [0.23, 0.0], r"brick\[1\] \(height, z\) must be a positive"),
+    ({"type": "facade", "youngs_modulus": 1e9}, [0.0, 0.08], r"brick\[0\] \(length, y\) must be a positive"),
+])
+def test_a_bad_brick_size_is_blamed_on_the_brick_not_the_joint(specimen, brick, message):
+    data = example_case("free-rocking")
+    data["specimen"] = dict(specimen, brick=brick)
+    with pytest.raises(ValueError, match=message):
+        parse_case(data)
+
+
+def test_an_earthquake_that_moves_nothing_is_refused(tmp_path):
+    data = example_case("free-rocking")
+    data["loading"] = {"type": "earthquake", "record": "elcentro-rsn6", "scale": 0.0}
+    with pytest.raises(ValueError, match=r"scale = 0 applies no ground motion"):
+        parse_case(data)
+    zero = tmp_path / "zero.txt"
+    zero.write_text("\n".join("0.0" for _ in range(50)))
+    data["loading"] = {"type": "earthquake", "record": str(zero), "units": "g", "dt": 0.01}
+    with pytest.raises(ValueError, match=r"its acceleration is zero at every sample"):
+        parse_case(data)
+
+
+def test_parquet_contacts_without_pyarrow_are_refused_before_the_run(monkeypatch):
+    import importlib.util
+
+    find = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "pyarrow" else find(name, *a))
+    data = example_case("free-rocking")
+    data["output"] = {"contacts": "parquet"}
+    with pytest.raises(ValueError, match=r'contacts = "parquet" needs pyarrow .* contacts = "csv"'):
+        parse_case(data)
+
+
+def test_frames_far_closer_than_a_step_are_refused():
+    from rockdem.run_cli import run_case
+
+    data = example_case("free-rocking")
+    data["run"].update(duration=0.05, record_interval=1e-7)
+    with pytest.raises(ValueError, match=r"record_interval = 1e-07 s puts [\d.e+]+ frames in each time step .* give record_interval >="):
+        run_case(parse_case(data))
+
+
+def _slider_model(speed: float, seconds: float):
+    """A cube resting on the ground and, beside it, a driven block moving at ``speed`` [m/s] along x
+    for ``seconds`` [s]."""
+    from rockdem.model import Motion
+
+    b = _builder()
+    b.add_box(0.2, 0.2, 0.2, density=2000, name="cube")
+    b.add_box(0.1, 0.1, 0.1, base_center=(0.7, 0.7, 0.3), driven=Motion.constant([speed, 0.0, 0.0], stop=seconds), name="slider")
+    return b.finalize(damping=Damping(beta=1e-4))
+
+
+def test_a_prescribed_motion_faster_than_the_step_is_refused_and_a_resolved_one_followed():
+    with pytest.raises(ValueError, match=r"driven block\(s\) \['slider'\]: the time step .* misses 100% of their prescribed motion"):
+        simulate(_slider_model(1e4, 1e-5), 0.05, progress=False)  # 0.1 m in a tenth of a step: it stayed where it was
+    ds = simulate(_slider_model(0.5, 0.2), 0.3, record_interval=0.01, progress=False)
+    moved = float(ds.block_position.sel(block="slider").isel(time=-1)[0] - ds.block_position.sel(block="slider").isel(time=0)[0])
+    assert moved == pytest.approx(0.1, rel=0.01)
+
+
+def test_a_rod_pushover_that_would_strike_the_specimen_is_refused_and_a_fast_one_warned_about():
+    from rockdem.loading import apply_rod_pushover
+
+    for speed, raises in ((10.0, True), (0.5, False)):
+        b = _builder()
+        b.add_box(0.2, 1.0, 1.0, density=1800, name="block")
+        if raises:  # sqrt(g H) = 3.1 m/s for the 1 m block
+            with pytest.raises(ValueError, match=r"pushover velocity = 10 m/s: the rod would strike the specimen"):
+                apply_rod_pushover(b, displacement=0.1, velocity=speed)
+        else:
+            with pytest.warns(UserWarning, match=r"pushover velocity = 0.5 m/s is above 0.05 sqrt\(g H\)"):
+                apply_rod_pushover(b, displacement=0.1, velocity=speed)
+
+
+def test_implausible_rocking_speed_and_joint_stiffness_and_no_support():
+    data = example_case("free-rocking")
+    data["specimen"] = {"type": "facade", "youngs_modulus": 1e9, "rocking_velocity": 1e6}
+    data["loading"] = {"type": "gravity"}
+    with pytest.raises(ValueError, match=r"rocking_velocity = 1e\+06 rad/s moves the façade's top at .* \(rad/s, not deg/s\)"):
+        parse_case(data)
+    data["specimen"]["rocking_velocity"] = 2.0  # a strong rocking: accepted
+    parse_case(data)
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e15)
+    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.2, 0.5, 1.0, density=2000, name="block")
+    with pytest.warns(UserWarning, match=r"kn = 1e\+15 .* stiffer than any material"):
+        b.finalize(damping=Damping(beta=1e-6))
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e9)
+    b.add_box(0.2, 0.5, 1.0, density=2000, base_center=(0, 0, 1.0), name="block")
+    with pytest.warns(UserWarning, match=r"no driven block: nothing supports its free blocks"):
+        b.finalize(damping=Damping(beta=1e-4))
+
+
+def test_a_file_that_is_not_a_result_is_refused_without_netcdf_advice(tmp_path):
+    from rockdem.plots import read_result_file
+
+    npz = tmp_path / "checkpoint.npz"
+    np.savez(npz, a=np.zeros(3))
+    with pytest.raises(ValueError, match=r"not a rockdem result: not a NetCDF file \(a checkpoint") as err:
+        read_result_file(npz)
+    assert "engine" not in str(err.value)
+    text = tmp_path / "case.toml"
+    text.write_text(_case_text())
+    with pytest.raises(ValueError, match=r"not a rockdem result: not a NetCDF file; give the result.nc"):
+        read_result_file(text)
+
+
+def test_a_load_along_y_is_measured_about_its_own_axis_in_the_python_api():
+    """apply_earthquake, apply_pushover and apply_rod_pushover set the default rocking axis to up x d,
+    so that rocking_angle tips blocks along the load (before 2026-11-30 an earthquake along y was
+    measured about y: an overturned block read 0 rad, "not overturned")."""
+    from rockdem.analysis import summarize_result
+    from rockdem.loading import apply_earthquake, apply_pushover
+    from rockdem.records import GroundMotion
+
+    b = _builder()
+    b.add_box(0.6, 0.2, 1.2, density=2000, name="block")  # slender along y
+    apply_earthquake(b, GroundMotion(np.full(50, 2.0), 0.01), direction=(0, 1, 0), mode="inertial")
+    assert np.allclose(b.finalize(damping=Damping(beta=1e-4)).rocking_axis, [-1.0, 0.0, 0.0])
+    b = _builder()
+    b.add_box(0.6, 0.2, 1.2, density=2000, name="block")
+    apply_pushover(b, rate=20.0, max_load_factor=1.0, direction=(0, 1, 0))  # 1 g sideways: far above B / H = 1/6
+    ds = simulate(b.finalize(damping=Damping(beta=1e-4)), 0.4, record_interval=0.01, progress=False)
+    turned = np.linalg.norm(ds.block_rotation.sel(block="block").values[-1])
+    assert turned > 0.05
+    assert float(ds.rocking_angle.sel(block="block")[-1]) == pytest.approx(turned, rel=1e-6)  # towards +y
+    assert summarize_result(ds, block="block")["max_rotation_rad"] == pytest.approx(turned, rel=1e-6)
+    with pytest.raises(ValueError, match=r"block 'nope' not in the result; give one of \['ground', 'block'\]"):
+        summarize_result(ds, block="nope")
