@@ -152,12 +152,8 @@ def _lean_flush(m, s, sc, dt, pairs, reps):  # type: ignore[no-untyped-def]
                 energy += 0.5 * (fn * un + ksa * (us0 * us0 + us1 * us1 + us2 * us2))
                 f0, f1, f2 = fn * n0 + ksa * us0, fn * n1 + ksa * us1, fn * n2 + ksa * us2
                 r0, r1, r2 = x0 - s.position[o, 0], x1 - s.position[o, 1], x2 - s.position[o, 2]
-                sf0 += f0
-                sf1 += f1
-                sf2 += f2
-                sm0 += r1 * f2 - r2 * f1
-                sm1 += r2 * f0 - r0 * f2
-                sm2 += r0 * f1 - r1 * f0
+                sf0, sf1, sf2 = sf0 + f0, sf1 + f1, sf2 + f2  # the resultant and its moment about o's centroid
+                sm0, sm1, sm2 = sm0 + (r1 * f2 - r2 * f1), sm1 + (r2 * f0 - r0 * f2), sm2 + (r0 * f1 - r1 * f0)
             sc.side_force[i, 0, 0], sc.side_force[i, 0, 1], sc.side_force[i, 0, 2] = sf0, sf1, sf2
             sc.side_moment[i, 0, 0], sc.side_moment[i, 0, 1], sc.side_moment[i, 0, 2] = sm0, sm1, sm2
             sc.side_elastic[i, 0] = energy
