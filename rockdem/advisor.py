@@ -71,6 +71,11 @@ class Configuration(str, enum.Enum):
     ONE_SIDED = "one-sided"
 
 
+PLAUSIBLE_BLOCK = 100.0
+"""[m] the largest width, height or length the advisor takes: a masonry wall or tower is tens of
+metres; "--width 200 --height 2000" was mm typed as m (and got beta = 0.28 s)."""
+
+
 @dataclass(frozen=True, kw_only=True)
 class AdviceInput:
     """Inputs of the advisor (SI units).
@@ -124,6 +129,13 @@ class AdviceInput:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
                 raise ValueError(f"{name} must be a positive integer, got {v!r}")
+        if self.points < 2:  # as the engine's builders refuse it (rockdem run: [specimen] points_across)
+            raise ValueError("points = 1 puts the base's only point at its middle: the block balances on a knife edge and "
+                             "cannot rock about its edges; give 2 or more (the paper uses 2 to 15)")
+        for name in ("width", "height", "length"):
+            if getattr(self, name) > PLAUSIBLE_BLOCK:
+                raise ValueError(f"{name} = {getattr(self, name):g} m is larger than any masonry block or wall "
+                                 f"(at most {PLAUSIBLE_BLOCK:g} m here): lengths are in metres, not mm")
         if self.configuration is None:
             object.__setattr__(self, "configuration_implied", True)
             object.__setattr__(self, "configuration", Configuration.STACKED if self.blocks > 1 else Configuration.SINGLE)
@@ -144,6 +156,9 @@ class AdviceInput:
             and 0.0 < self.release_fraction < 1.0
         ):
             raise ValueError(f"release_fraction must lie in (0, 1) (a fraction of eta), got {self.release_fraction!r}")
+        if self.release_fraction is not None and self.target_restitution is None:
+            raise ValueError("release_fraction is the release of the target_restitution probe; give target_restitution "
+                             "too (on the command line --target-restitution, e.g. 0.95eta), or leave it out")
         if self.youngs_modulus < 1e6:
             raise ValueError(
                 f"youngs_modulus = {self.youngs_modulus!r} Pa is below 1 MPa: E is in Pa "
@@ -177,7 +192,8 @@ class Advice:
     omega_c: float = _out("rad/s", "Eq. 1, 3: sqrt(k_s / m_b)", "omega_c (corner)")
     omega_e: float = _out("rad/s", "Eq. 1, 3: sqrt(2 k_s / m_b)", "omega_e (edge)")
     omega_r: float = _out("rad/s", "Eq. 1 + 2: sqrt(3 k_s B^2 / (m_b (B^2 + h^2))) (Eq. 3's B^3 is a typo)", "omega_r (rotational)")
-    omega_crit: float = _out("rad/s", "§2.2: omega_e; x sqrt 2 stacked; B<->h and x sqrt 2 one-sided", "omega_crit")
+    omega_crit: float = _out("rad/s", "§2.2: omega_e (the largest of the three for H/B <= sqrt 2); x sqrt 2 stacked; "
+                             "B<->h and x sqrt 2 one-sided", "omega_crit")
     beta_sp: float = _out("s", "Eq. 4 (alpha = 0): beta = 2 zeta / omega_crit", "beta (SP only)")
     rayleigh_alpha: float = _out("1/s", "Eq. 5: alpha = zeta omega_crit", "Rayleigh alpha (min at omega_crit)")
     rayleigh_beta: float = _out("s", "Eq. 5: beta = zeta / omega_crit", "Rayleigh beta (min at omega_crit)")
@@ -474,6 +490,14 @@ def model_beta(i: AdviceInput) -> BetaChoice:
     return model.beta_choice
 
 
+def _crit_name(i: AdviceInput) -> str:
+    """What omega_crit is for ``i``: omega_e, or for a squat rocking body (h/B <= sqrt 2, where the
+    paper's ordering of the impact frequencies does not hold) the largest of the three."""
+    h = i.height / i.blocks if i.configuration is Configuration.STACKED else i.height  # the rocking body's
+    squat = i.configuration is not Configuration.ONE_SIDED and h / i.width <= math.sqrt(2.0)
+    return "max(omega_c, omega_e, omega_r) (h/B <= sqrt 2)" if squat else "omega_e"
+
+
 def _recommended(i: AdviceInput, beta_rule: float, choice: BetaChoice | None) -> tuple[float, str]:
     """The beta the advisor would use [s] and why."""
     if choice is not None and choice.mode == "auto":
@@ -494,7 +518,7 @@ def _recommended(i: AdviceInput, beta_rule: float, choice: BetaChoice | None) ->
     rule = "x sqrt 2 (stacked, §2.2)" if i.configuration is Configuration.STACKED else (
         "B and h swapped x sqrt 2 (one-sided, §2.2)" if i.configuration is Configuration.ONE_SIDED else "(§2.2)")
     return beta_rule, (
-        f"DeJong's rule as in the paper: beta = 2 zeta / omega_crit, omega_crit = omega_e of Eq. 3 {rule}. It does not "
+        f"DeJong's rule as in the paper: beta = 2 zeta / omega_crit, omega_crit = {_crit_name(i)} of Eq. 3 {rule}. It does not "
         "depend on the interface points and over-damped the §4.1 parapet; give --target-restitution (e.g. 0.95eta) "
         "for the beta whose impacts give a chosen restitution, or --per-interface for each pair's own critical beta."
     )

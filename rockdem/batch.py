@@ -117,14 +117,6 @@ def frames_from_run(case: Case, out: Any) -> Frames:
     )
 
 
-def _specimen_eta(data: Mapping[str, Any]) -> float | None:
-    """atan(width / height) of a ``block`` specimen, else None."""
-    sp = data.get("specimen", {})
-    if sp.get("type") == "block" and "width" in sp and "height" in sp:
-        return float(np.arctan2(float(sp["width"]), float(sp["height"])))
-    return None
-
-
 def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]:
     """The summary row of a run of ``spec`` (a :class:`rockdem.studies.RunSpec`) with case dict
     ``data`` (keys: see :func:`rockdem.studies.run_spec`); ``wall_s`` is added by the caller.
@@ -143,8 +135,10 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
     b = int(free[0])
     t = f.time
     theta = np.asarray(f.rocking[:, b], dtype=float)
-    eta = _specimen_eta(data)
-    eta_used = eta if eta is not None else eta_of(f.attrs, f.block_eta, b)
+    # The block's own angle about the run's rocking axis (the result's block_eta, as rockdem run's
+    # summary): before 2026-11-30 a block specimen took atan(width / height) whatever the load's
+    # direction, so a block rocking along y (about its length) was judged against its width's angle.
+    eta_used = eta_of(f.attrs, f.block_eta, b)
     starts = f.block_vertex_start
     z = lowest_vertex_height(f.position[:, b], f.quaternion[:, b], f.vertex_local[starts[b] : starts[b + 1]])
     with warnings.catch_warnings():
@@ -163,7 +157,7 @@ def summary_row(spec: Any, data: Mapping[str, Any], f: Frames) -> dict[str, Any]
         if a.get("stop_reason") in ("overturned", "fell"):
             row["stop_block"] = a.get("stop_block")
     row["max_rotation_rad"] = float(s["max_rotation_rad"])
-    eta = eta or s.get("eta_rad")  # a released assembly: the assembly's angle
+    eta = eta_used or s.get("eta_rad")
     row["max_rotation_over_eta"] = float(s["max_rotation_rad"] / eta) if eta else None
     row["overturned"] = bool(s.get("overturned", False))
     row["fallen_blocks"] = int(np.count_nonzero(fallen(

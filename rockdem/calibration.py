@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ._warn import warn_user
-from .analysis import wme
+from .analysis import rest_time, wme
 from .plots import save_figure
 from .case import parse_assignment
 from .studies import RunSpec, Store, check_first_run, execute, resolve_base, with_stop
@@ -149,6 +149,21 @@ def failure_of_row(row: Mapping[str, Any]) -> str | None:
     if row.get("status") != "ok":
         return f"diverged at {row.get('diverged_time_s', '?')} s" if row.get("status") == "diverged" else str(row.get("status"))
     return None
+
+
+def _check_reference_span(ref: Reference, duration: Any) -> None:
+    """Refuse, before any run, a reference that does not move (the WME's cut at rest leaves nothing to
+    compare) and a duration that ends before its motion does (the WME would refuse every run:
+    before 2026-11-30 the command said so only after the first run, naming options of the Python
+    function, not of the command)."""
+    t_end = rest_time(ref.time, ref.value)
+    if np.count_nonzero(ref.time <= t_end) < 2:
+        raise ValueError(f"the reference's {ref.quantity} never moves by more than 1 % of its range from "
+                         "its end value, so there is nothing to calibrate against; check the file and its column")
+    if isinstance(duration, (int, float)) and not isinstance(duration, bool) and float(duration) < t_end:
+        raise ValueError(f"duration = {float(duration):g} s ends before the reference's motion does ({t_end:.4g} s): "
+                         f"the runs could not be compared over it; give at least {t_end:.4g} s (--duration), or leave "
+                         "the duration out (the reference's length)")
 
 
 def wme_of_row(row: Mapping[str, Any], ref: Reference) -> float:
@@ -276,6 +291,7 @@ def calibrate(
     fixed = with_stop(fixed, stop)
     # the duration: given, else a fixed run.duration, else the reference's last time
     dur = float(duration) if duration is not None else None if "run.duration" in fixed else float(reference.time[-1])
+    _check_reference_span(reference, dur if dur is not None else fixed.get("run.duration"))
     evals: list[dict[str, Any]] = []
     cache: dict[str, float] = {}
 

@@ -84,6 +84,13 @@ class Fragility:
             return norm.cdf(np.log(np.maximum(im, 1e-300) / self.theta) / self.beta)
 
 
+MAX_DISPERSION = 5.0
+"""Largest lognormal dispersion beta [-] a fit may return (fragilities of structures have 0.2 to 1):
+outcomes whose failures do not rise with the intensity drive the likelihood's best beta to
+infinity (a failure at 0.25 g and a survival at 0.31 g fitted a median of 0.0047 g and a
+dispersion of 4.9e18 before 2026-11-30), and :func:`fit_fragility_mle` refuses them."""
+
+
 def fit_fragility_mle(im: Sequence[float], failed_: Sequence[bool] | Sequence[int], trials: Sequence[int] | None = None) -> Fragility:
     """Maximum-likelihood lognormal fragility from outcomes (Baker 2015, binomial likelihood).
 
@@ -110,14 +117,23 @@ def fit_fragility_mle(im: Sequence[float], failed_: Sequence[bool] | Sequence[in
 
     def nll(p: np.ndarray) -> float:
         mu, lb = p
-        pr = np.clip(norm.cdf((lx - mu) / np.exp(lb)), 1e-12, 1 - 1e-12)
+        with np.errstate(over="ignore", invalid="ignore"):
+            pr = np.clip(norm.cdf((lx - mu) / np.exp(lb)), 1e-12, 1 - 1e-12)
         return -float(np.sum(z * np.log(pr) + (n - z) * np.log(1 - pr)))
 
     # start: median where half the analyses fail, dispersion from the spread of intensities
     p0 = np.array([float(np.sum(lx * n) / n.sum()), np.log(max(float(np.std(lx)), 0.1))])
     res = minimize(nll, p0, method="Nelder-Mead", options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000})
+    with np.errstate(over="ignore"):
+        theta, beta = float(np.exp(res.x[0])), float(np.exp(res.x[1]))
+    if not beta <= MAX_DISPERSION:
+        levels, where = np.unique(x, return_inverse=True)
+        rate = [f"{lv:.4g}: {np.sum(z[where == k]):g}/{np.sum(n[where == k]):g}" for k, lv in enumerate(levels)]
+        raise ValueError(f"fit_fragility_mle: the failures do not rise with the intensity (failed/analyses by intensity "
+                         f"{', '.join(rate[:6])}{' ...' if len(rate) > 6 else ''}): the best lognormal would have a "
+                         f"dispersion of {beta:.3g}, beyond {MAX_DISPERSION:g}; no fragility. Add records or levels")
     sep = bool(x[z < n].max() <= x[z > 0].min())  # every level with a failure at or above every one with a survival
-    return Fragility(float(np.exp(res.x[0])), float(np.exp(res.x[1])), int(n.sum()), separated=sep)
+    return Fragility(theta, beta, int(n.sum()), separated=sep)
 
 
 def fit_fragility_capacities(capacities: Sequence[float]) -> Fragility:
@@ -308,6 +324,23 @@ def _cut_short(specs: Sequence[RunSpec]) -> list[str]:
     return notes
 
 
+def _check_records(records: Sequence[str]) -> None:
+    """Refuse, before any run, a record that names no file, and two names of one file (a short
+    name, its file name, a path: before 2026-11-30 each ran and counted as a record of its own in
+    the fit, and a misspelt name failed only after the other records had run)."""
+    from .loading import resolve_record
+
+    seen: dict[Path, str] = {}
+    for r in records:
+        try:
+            path = resolve_record(r).resolve()
+        except (FileNotFoundError, ValueError) as exc:
+            raise ValueError(f"record {r!r}: {exc}") from None
+        if path in seen:
+            raise ValueError(f"records {seen[path]!r} and {r!r} are the same file ({path.name}); give each record once")
+        seen[path] = str(r)
+
+
 def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequence[float], out: str | os.PathLike[str], *,
             fixed: Mapping[str, Any] | None = None, duration: float | None = None, drift_limit: float | None = None,
             im: str = "pga_g", period: float | None = None, stop: str = "decided", executor: str = "process",
@@ -341,6 +374,7 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
     if isinstance(records, str) or len(records) == 0 or len(pga_g) == 0:
         raise ValueError(f"give a list of at least one record and one PGA level [g], got records={records!r}, pga_g={pga_g!r}")
     failed(pd.DataFrame({"overturned": []}), drift_limit)  # drift_limit checked before any run
+    _check_records(records)
     specs = ida_specs(base, records, pga_g, fixed=fixed, duration=duration, stop=stop)
     _check_cases(specs, len(pga_g))
     notes = _cut_short(specs[::len(pga_g)])
@@ -636,7 +670,8 @@ def _fragility_cli(args: argparse.Namespace) -> int:
         if len(reasons) > 3:
             print(f"  ... {len(reasons) - 3} more reasons in the table's error column", file=sys.stderr)
     if frag is None:
-        print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did; widen the PGA range)")
+        print(f"fragility against {IM_COLUMNS[args.im]}: not fitted (every completed run failed, or none did, or the "
+              "failures do not rise with the intensity; widen the PGA range, or add records or levels)")
     else:
         print(f"fragility against {IM_COLUMNS[args.im]}: median {frag.theta:.4g}, dispersion {frag.beta:.4g}"
               + (" (separated outcomes: the dispersion is not identifiable, report.md)" if frag.separated else ""))

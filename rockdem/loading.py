@@ -484,8 +484,10 @@ def apply_rod_pushover(
         # rod and the face moving together in a quasi-static push
         omega = math.sqrt(base.kn * rod_size * span / mass)
         material = replace(base, friction_angle=0.0, cohesion=0.0, tension=0.0, residual_friction_angle=0.0, beta=2.0 / omega)
-    groups = {builder.group(n) for n in free}
-    for g in groups:
+    # The rod's joint with every group: the free blocks' (the push), and the driven ones' too, which
+    # it never touches but the model needs a material for every pair (given a material and no
+    # default, finalize() refused the rod-foundation pair before 2026-11-30).
+    for g in {builder.group(n) for n in builder.block_names()} | {"pushover_rod"}:
         builder.set_material("pushover_rod", g, material)
     # smooth start and stop (half-cosine speed ramps over 20 % of the push time each, no impact
     # on the face); the ramps lose and gain the same distance, so displacement = velocity * push_time

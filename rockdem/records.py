@@ -398,7 +398,14 @@ _NPTS_RE = re.compile(r"NPTS\s*[=:]\s*(\d+)", re.IGNORECASE)
 _DT_RE = re.compile(rf"(?<![A-Za-z])DT\s*[=:]\s*([+-]?{_UNSIGNED})", re.IGNORECASE)
 # Older PEER header: "  4000    0.01000   NPTS, DT"
 _OLD_NPTS_DT_RE = re.compile(rf"^\s*(\d+)[\s,]+({_UNSIGNED})\s+NPTS\s*,?\s*DT", re.IGNORECASE)
-_UNITS_RE = re.compile(r"UNITS\s+(?:OF|ARE|IN|:)?\s*\(?\s*([A-Za-z'/^*0-9]+)", re.IGNORECASE)
+_PER_S2 = r"\s*/\s*(?:s|sec|second)s?\s*(?:\^\s*2|\*\*\s*2|2|/\s*(?:s|sec|second)s?)"
+_HEADER_UNITS = (
+    (AccelerationUnit.CM_S2, re.compile(rf"(?<![a-z])(?:cm|centimet(?:er|re)s?){_PER_S2}|(?<![a-z])gals?(?![a-z])", re.IGNORECASE)),
+    (AccelerationUnit.M_S2, re.compile(rf"(?<![a-z])(?:m|met(?:er|re)s?){_PER_S2}", re.IGNORECASE)),
+    (AccelerationUnit.G, re.compile(r"units?\s*(?:of|are|in|:|=)?\s*[(\[']?\s*g(?:'s)?(?![a-z/])|\(g\)", re.IGNORECASE)),
+)
+"""Acceleration units as AT2 headers state them: ``UNITS OF G``, ``The units are (g)``, ``Units:
+cm/s^2``, ``ACCELERATION IN CM/SEC**2``, ``(gal)``, ``M/S/S``, ..."""
 _NOT_ACCEL_RE = re.compile(r"\b(VELOCITY|DISPLACEMENT)\b.*\bUNITS?\b", re.IGNORECASE)
 
 
@@ -416,9 +423,9 @@ def _half_last_digit(text: str) -> float:
     return 0.5 * 10.0 ** (-decimals + (int(exponent) if exponent else 0))
 
 
-def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, AccelerationUnit | None, float]:
-    """Line index of the NPTS/DT line, NPTS, DT [s], the header's units (None if not stated) and
-    the rounding of DT as written [s] (half a unit in its last digit)."""
+def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, float]:
+    """Line index of the NPTS/DT line, NPTS, DT [s] and the rounding of DT as written [s] (half a
+    unit in its last digit)."""
     for i, line in enumerate(lines[:_HEADER_SCAN_LINES]):
         m_n, m_dt = _NPTS_RE.search(line), _DT_RE.search(line)
         old = _OLD_NPTS_DT_RE.search(line)
@@ -429,17 +436,28 @@ def _at2_header(p: Path, lines: list[str]) -> tuple[int, int, float, Acceleratio
         else:
             continue
         dt = float(dt_text.replace("D", "E").replace("d", "e"))
-        header_units = None
         for head in lines[:i]:
             if _NOT_ACCEL_RE.search(head):
                 raise ValueError(f"{p}: the header says {head.strip()!r}; rockdem reads acceleration records "
                                  "(use the matching .AT2 acceleration file)")
-            m_u = _UNITS_RE.search(head)
-            if m_u:
-                header_units = _parse_units(m_u.group(1).rstrip(").,"), f"{p}: header units")
-        return i, npts, dt, header_units, _half_last_digit(dt_text)
+        return i, npts, dt, _half_last_digit(dt_text)
     raise ValueError(f"{p}: no 'NPTS= ..., DT= ...' header line in the first {_HEADER_SCAN_LINES} lines; "
                      "for a headerless file use read_single_column(path, dt=..., units=...) or read_columns")
+
+
+def _header_units(head: list[str]) -> tuple[AccelerationUnit | None, str]:
+    """The acceleration units the header lines ``head`` state (:data:`_HEADER_UNITS`; None when
+    they name none), and why they cannot be taken ("" when they can): two different units, or a
+    line that speaks of units in a form not read here (such headers were read as g before
+    2026-11-30: "Units: cm/s^2" gave a record of 196 g)."""
+    found = sorted({(unit.value, line.strip()) for line in head for unit, pattern in _HEADER_UNITS if pattern.search(line)})
+    units = {unit for unit, _ in found}
+    if len(units) > 1:
+        return None, f"the header names several units ({'; '.join(line for _, line in found)})"
+    if units:
+        return AccelerationUnit(units.pop()), ""
+    unread = [line.strip() for line in head if re.search(r"\bunits?\b", line, re.IGNORECASE)]
+    return None, f"the header speaks of units rockdem cannot read ({unread[0]!r})" if unread else ""
 
 
 def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | None = None,
@@ -469,7 +487,10 @@ def read_at2(path: str | os.PathLike[str], *, units: str | AccelerationUnit | No
             different from NPTS, bad units or dt.
     """
     p, lines = _read_lines(path)
-    i_head, npts, dt_head, header_units, rounding = _at2_header(p, lines)
+    i_head, npts, dt_head, rounding = _at2_header(p, lines)
+    header_units, problem = _header_units(lines[:i_head])
+    if problem and units is None:
+        raise ValueError(f"{p}: {problem}; give units ('g', 'm/s2' or 'cm/s2')")
     unit = header_units or AccelerationUnit.G
     if units is not None:
         unit = _parse_units(units, f"{p}: units")

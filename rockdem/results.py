@@ -201,19 +201,30 @@ class EnergyCheck(NamedTuple):
     scale: float
 
 
+def energy_balance(energy: np.ndarray) -> tuple[np.ndarray, float]:
+    """The energy balance error (T,) [J] of recorded energies ``energy`` (T >= 1, len(ENERGY_NAMES))
+    [J] (columns in the order of :data:`ENERGY_NAMES`, ``Records.energy``): kinetic + potential +
+    elastic + dissipated - work, less its initial value; and the run's energy scale [J], the
+    largest kinetic + elastic + |potential change| + dissipated + |work| (as the result's
+    ``energy_balance_error_relative`` divides by)."""
+    e = np.asarray(energy, dtype=float)
+    work = e[:, W_DRIVEN] + e[:, W_BODY]
+    lost = sum(e[:, k] for k in (E_DAMPING_MASS, E_DAMPING_STIFFNESS, E_FRICTION, E_BOND, E_LOCAL_DAMPING))
+    total = e[:, E_KINETIC] + e[:, E_POTENTIAL] + e[:, E_ELASTIC] - work + lost
+    scale = e[:, E_KINETIC] + e[:, E_ELASTIC] + np.abs(e[:, E_POTENTIAL] - e[0, E_POTENTIAL]) + lost + np.abs(work)
+    return total - total[0], float(np.max(scale))
+
+
 def energy_check(energy: np.ndarray) -> EnergyCheck:
     """:class:`EnergyCheck` of recorded energies ``energy`` (T, len(ENERGY_NAMES)) [J], columns in the
     order of :data:`ENERGY_NAMES` (``Records.energy``)."""
     e = np.asarray(energy, dtype=float)
     if len(e) == 0:
         return EnergyCheck(0.0, 0.0, 0.0)
-    work = e[:, W_DRIVEN] + e[:, W_BODY]
-    net = e[:, E_KINETIC] + e[:, E_POTENTIAL] + e[:, E_ELASTIC] - work
+    net = e[:, E_KINETIC] + e[:, E_POTENTIAL] + e[:, E_ELASTIC] - e[:, W_DRIVEN] - e[:, W_BODY]
     created = float(np.max(net - np.minimum.accumulate(net)))
-    lost = sum(e[:, k] for k in (E_DAMPING_MASS, E_DAMPING_STIFFNESS, E_FRICTION, E_BOND, E_LOCAL_DAMPING))
-    total = net + lost
-    scale = e[:, E_KINETIC] + e[:, E_ELASTIC] + np.abs(e[:, E_POTENTIAL] - e[0, E_POTENTIAL]) + lost + np.abs(work)
-    return EnergyCheck(created, float(total[-1] - total[0]), float(np.max(scale)))
+    err, scale = energy_balance(e)
+    return EnergyCheck(created, float(err[-1]), scale)
 
 
 def build_dataset(

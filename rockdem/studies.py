@@ -154,6 +154,9 @@ class RunSpec:
             out["history_xyz"] = True
         if self.record is not None:
             out["record_sha1"] = _file_sha1(self.record)
+        files = {k: v for k, v in _record_files(self.case_dict()).items() if not (k == "record" and self.record is not None)}
+        if files:  # the base case's or an override's own record files (not shipped ones): edited, a new run
+            out["files_sha1"] = files
         return out
 
     @property
@@ -191,14 +194,39 @@ class RunSpec:
         return data
 
 
-@functools.lru_cache(maxsize=256)
 def _file_sha1(record: str) -> str:
+    """sha1 of a record's file (a shipped name or a path), "missing" when there is none."""
     from .loading import resolve_record
 
     try:
-        return hashlib.sha1(resolve_record(record).read_bytes()).hexdigest()
-    except (FileNotFoundError, ValueError):
+        path = resolve_record(record)
+        stat = path.stat()
+    except (FileNotFoundError, ValueError, OSError):
         return "missing"
+    return _path_sha1(str(path), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=256)
+def _path_sha1(path: str, mtime_ns: int, size: int) -> str:
+    """sha1 of the file at ``path``, cached while its modification time and size stay the same."""
+    try:
+        return hashlib.sha1(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return "missing"
+
+
+def _record_files(data: Mapping[str, Any]) -> dict[str, str]:
+    """sha1 of the record files a case's earthquake loading reads (``record``, ``vertical``), by
+    key; shipped records (fixed by their SHA-256) are left out, so their runs keep their ids.
+    Before 2026-11-30 a sweep whose base case read a record file reused its old results after
+    the file was edited."""
+    from .records import SHIPPED_RECORDS
+
+    load = data.get("loading")
+    if not isinstance(load, Mapping) or load.get("type") != "earthquake":
+        return {}
+    shipped = {r.name for r in SHIPPED_RECORDS}
+    return {key: _file_sha1(v) for key in ("record", "vertical") if isinstance(v := load.get(key), str) and v not in shipped}
 
 
 def _positive(value: Any, what: str) -> float:
@@ -723,6 +751,10 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
     """Build a :class:`Study` from a dict of the study file format (see docs/studies.md)."""
     if not isinstance(data, Mapping) or not isinstance(data.get("study"), Mapping):
         raise ValueError("a study file needs a [study] table (base, duration, grid/list/random)")
+    outside = sorted(set(data) - {"study"})
+    if outside:
+        raise ValueError(f"the study file has {outside} outside [study]: every key of a study lies in [study] or its "
+                         "sub-tables ([study.grid], [study.list], [study.random], [study.set]); e.g. [grid] is [study.grid]")
     s = dict(data["study"])
     allowed = {"base", "duration", "executor", "workers", "scheduler", "set", "grid", "list", "random", "history",
                "history_interval", "name", "stop"}
@@ -750,6 +782,9 @@ def parse_study(data: Mapping[str, Any], *, relative_to: str | os.PathLike[str] 
             parts.append(expand_grid(s["grid"]))
         if "list" in s:
             lst = s["list"]
+            if isinstance(lst, Mapping) and set(lst) - {"rows"}:
+                raise ValueError(f"list: unknown key(s) {sorted(set(lst) - {'rows'})}; [study.list] holds rows = [...] "
+                                 "(or give list = [...] directly)")
             parts.append(expand_list(lst["rows"] if isinstance(lst, Mapping) and "rows" in lst else lst))
         if "random" in s:
             r = s["random"]

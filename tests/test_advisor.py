@@ -240,3 +240,16 @@ def test_advisor_per_interface_betas_of_a_one_sided_facade(capsys: pytest.Captur
     assert "sqrt(kn A / m)" in base.how and "per interface" in adv.recommended_why.lower()
     text = adv.table()
     assert "Recommended beta" in text and "facade-return: beta" in text
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"points": 1}, r"points = 1 .* knife edge .* give 2 or more"),
+    ({"width": 200.0, "height": 2000.0}, r"width = 200 m is larger than any masonry block .* not mm"),
+    ({"release_fraction": 0.5}, r"release_fraction is the release of the target_restitution probe"),
+])
+def test_advice_inputs_a_run_would_refuse_or_ignore_are_refused(kwargs, message):
+    """Before 2026-11-30 these were accepted: one point gave a full table (the engine refuses it),
+    mm typed as m a beta of 0.28 s, and a release fraction without a target was ignored."""
+    inputs = {"width": 0.2, "height": 2.0, "density": 1800.0, "youngs_modulus": 1.8e9, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        AdviceInput(**inputs)

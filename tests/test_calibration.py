@@ -31,7 +31,7 @@ def synthetic(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: _surface(r["beta"]))
 
 
-REF = Reference(np.linspace(0.0, 1.0, 11), np.ones(11))
+REF = Reference(np.linspace(0.0, 1.0, 11), 0.1 * np.cos(20.0 * np.linspace(0.0, 1.0, 11)))  # it moves (a flat one is refused)
 
 
 def test_reported_optimum_is_the_best_evaluated_point(synthetic) -> None:
@@ -127,3 +127,15 @@ def test_calibration_inputs_are_checked(synthetic, tmp_path) -> None:
     for column in (0, -1):
         with pytest.raises(ValueError, match="column must be 1 or more"):
             cal.load_reference(ref, column=column)
+
+
+def test_a_flat_reference_and_a_duration_short_of_its_motion_are_refused_before_any_run(monkeypatch) -> None:
+    """Before 2026-11-30 both failed at the first run's comparison, naming wme's Python options
+    (cut_at_rest=False, overlap_only=True) that the command does not have."""
+    monkeypatch.setattr(cal, "execute", lambda *a, **k: pytest.fail("a run was started"))
+    flat = Reference(np.linspace(0.0, 1.0, 11), np.ones(11))
+    with pytest.raises(ValueError, match=r"the reference's rotation never moves .* nothing to calibrate against"):
+        calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), flat, executor="serial")
+    moving = Reference(np.linspace(0.0, 4.0, 401), 0.1 * np.exp(-0.5 * np.linspace(0.0, 4.0, 401)) * np.cos(np.linspace(0.0, 40.0, 401)))
+    with pytest.raises(ValueError, match=r"duration = 1 s ends before the reference's motion does \(3.\d+ s\).*--duration"):
+        calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), moving, duration=1.0, executor="serial")

@@ -292,31 +292,35 @@ def test_threads_option(tmp_path, capsys):
 def test_a_sinking_block_is_found_when_it_sinks():
     # A block on joints far too soft (kn = 3e4 Pa/m, a timestep of several hundredths of a second)
     # sinks by 25 % of its thickness at 0.10 s (0.05 m = (g / w^2)(1 - cos w t), w = 4.08 1/s). The
-    # check runs at least every 5 % of the run (it ran once per compiled chunk, which could span the
-    # whole run, and reported the sinking at the run's end) and reads the overlaps of the last force
-    # pass, a step behind the positions: it finds the sinking within 0.1 s + 5 % of the run + a step
-    # (0.058 s). (Until 2026-11-29 the leapfrog's start ran half a step early and the bound without
-    # the step held.) A bad step found past the end is said to be "at the end of the run".
+    # check runs at fixed times, every SINK_CHECK_TIME here (it ran once per compiled chunk, which
+    # could span the whole run, then at least every 5 % of the run, so that the stop moved with the
+    # duration asked for, until 2026-11-30) and reads the overlaps of the last force pass, a step
+    # behind the positions, whose last step may pass the check time by a step: it finds the
+    # sinking within 0.1 s + SINK_CHECK_TIME + two steps (0.058 s each), at the same time for any
+    # duration. A bad step found past the end is said to be "at the end of the run".
     import warnings
 
     from rockdem.materials import JointMaterial
     from rockdem.model import ModelBuilder
     from rockdem.run_cli import summary_lines
-    from rockdem.simulation import SINK_CHECK_SHARE, simulate
+    from rockdem.simulation import SINK_CHECK_TIME, simulate
 
     b = ModelBuilder()
     b.default_material = JointMaterial(kn=3e4, friction_angle=30.0)
     b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
     b.add_box(0.2, 1, 1, density=1800, name="block")
     model = b.finalize()
-    for duration in (0.2, 2.0):
+    found = []
+    for duration in (0.4, 2.0):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ds = simulate(model, duration, progress=False)
         t_bad = ds.attrs["diverged_time"]
-        assert ds.attrs["diverged_reason"] == "sank" and t_bad < 0.1 + SINK_CHECK_SHARE * duration + ds.attrs["dt"]
+        found.append(t_bad)
+        assert ds.attrs["diverged_reason"] == "sank" and t_bad < 0.1 + SINK_CHECK_TIME + 2.0 * ds.attrs["dt"]
         lines = "\n".join(summary_lines(ds))
         assert f"DIVERGED at t = {t_bad:.4g} s: the result holds the frames up to it, the last ones already sinking" in lines
+    assert found[0] == found[1]  # the same stop for any duration asked for
     ds.attrs.update(duration=0.1, diverged_reason="energy")
     assert f"DIVERGED at the end of the run (its last step reached t = {t_bad:.4g} s): the result holds the sound frames" in "\n".join(summary_lines(ds))
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -278,3 +280,30 @@ def test_the_mle_fit_flags_separated_outcomes_and_refuses_bad_ones():
             fit_fragility_mle([0.1, 0.2, 0.3], outcome)
     with pytest.raises(ValueError, match="drift_limit must be a positive multiple of eta"):
         failed(pd.DataFrame({"overturned": [False]}), drift_limit=-1.0)
+
+
+@pytest.mark.parametrize("im, outcome", [
+    ([0.2, 0.2, 0.4, 0.4, 0.6, 0.6], [1, 0, 0, 0, 0, 0]),  # the only failure at the lowest level
+    ([0.25272, 0.30888], [1, 0]),  # rockdem fragility's two levels: failed at the lower one
+])
+def test_outcomes_whose_failures_do_not_rise_with_intensity_have_no_fragility(im, outcome):
+    """Before 2026-11-30 such outcomes gave a median of 0.0047 g and a dispersion of 4.9e18 (or
+    inf with an overflow warning), reported as a fragility."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow from the likelihood either
+        with pytest.raises(ValueError, match=r"the failures do not rise with the intensity .* no fragility"):
+            fit_fragility_mle(im, outcome)
+    table = pd.DataFrame({"pga_g": im, "failed": [bool(v) for v in outcome], "status": "ok"})
+    fits = fit_all(table)
+    assert np.isnan(fits.set_index("im").loc["pga_g", "theta"])
+
+
+@pytest.mark.parametrize("records, message", [
+    (["elcentro-rsn6", "ELCENTRO-RSN6"], r"records 'elcentro-rsn6' and 'ELCENTRO-RSN6' are the same file"),
+    (["elcentro-rsn6", "RSN6_IMPVALL.I_I-ELC180.AT2"], r"are the same file \(RSN6_IMPVALL.I_I-ELC180.AT2\)"),
+    (["elcentro-rsn6", "nosuch"], r"record 'nosuch': no record 'nosuch'"),
+])
+def test_an_ida_refuses_a_record_given_twice_or_missing_before_any_run(tmp_path, records, message):
+    with pytest.raises(ValueError, match=message):
+        run_ida("free-rocking", records, [0.3], tmp_path / "ida", duration=0.1, executor="serial", progress=False)
+    assert not (tmp_path / "ida").exists()  # nothing run, nothing written

@@ -557,3 +557,34 @@ def test_misread_files_say_how_to_read_them(tmp_path: Path) -> None:
     half = _write(tmp_path, "half_ms.txt", "".join(f"{2.5 * k} 0.1\n" for k in range(20)))  # 2.5 ms steps, in ms
     with pytest.warns(UserWarning, match="a time step of 2.5 s.*milliseconds"):
         read_record(half, units="g")
+
+
+@pytest.mark.parametrize("line, units", [
+    ("Units: cm/s^2", "cm/s2"), ("acceleration (gal)", "cm/s2"), ("UNITS: CM/S**2", "cm/s2"),
+    ("ACCELERATION IN CM/SEC**2", "cm/s2"), ("UNITS OF CM/S/S", "cm/s2"), ("Units: m/s2", "m/s2"), ("M/S/S", "m/s2"),
+    ("ACCELERATION TIME SERIES IN UNITS OF G", "g"), ("The units are (g)", "g"), ("synthetic record", "g"),
+])
+def test_at2_header_units_are_read_as_written(tmp_path, line, units):
+    """Before 2026-11-30 a header that wrote its units otherwise than 'UNITS OF ...' was read as g:
+    "Units: cm/s^2" gave a record of 196 g. A header without units is g (the NGA convention)."""
+    from rockdem.records import read_at2
+
+    f = tmp_path / "r.AT2"
+    f.write_text(f"PEER NGA STRONG MOTION DATABASE RECORD\nsynthetic, station Galway\n{line}\nNPTS=   3, DT=   .0100 SEC,\n 100.0 -50.0 0.0\n")
+    g = read_at2(f)
+    assert g.units_in == units
+    assert g.pga == pytest.approx({"g": 100.0 * 9.80665, "m/s2": 100.0, "cm/s2": 1.0}[units])
+
+
+@pytest.mark.parametrize("line, message", [
+    ("Units: furlongs per fortnight", "speaks of units rockdem cannot read"),
+    ("UNITS OF G (peak 200 CM/S2)", "names several units"),
+])
+def test_at2_header_units_that_cannot_be_read_ask_for_units(tmp_path, line, message):
+    from rockdem.records import read_at2
+
+    f = tmp_path / "r.AT2"
+    f.write_text(f"PEER NGA STRONG MOTION DATABASE RECORD\nsynthetic\n{line}\nNPTS=   3, DT=   .0100 SEC,\n 1.0 -0.5 0.0\n")
+    with pytest.raises(ValueError, match=rf"{message} .*give units"):
+        read_at2(f)
+    assert read_at2(f, units="cm/s2").pga == pytest.approx(0.01)  # given: taken

@@ -430,3 +430,46 @@ def test_study_inputs_that_would_run_otherwise_than_written_are_refused_or_warne
     with pytest.warns(UserWarning, match=r"1 of the 2 runs repeat another run's settings .*damping.beta = 0.002"):
         rows = execute(twice, tmp_path / "s", executor="serial", progress=False)
     assert len(rows) == 1
+
+
+def test_an_edited_record_file_of_the_base_case_is_a_new_run(tmp_path):
+    """A sweep whose base case reads a record file reran nothing after the file was edited (same
+    ids, the old results) before 2026-11-30; its runs now hash the file. A shipped record's runs
+    keep their ids (the file is fixed by its SHA-256)."""
+    rec = tmp_path / "r.txt"
+    rec.write_text("0.0\n0.1\n-0.1\n0.0\n")
+    base = example_case("free-rocking")
+    base["loading"] = {"type": "earthquake", "record": str(rec), "units": "g", "dt": 0.01, "mode": "inertial"}
+    before = RunSpec.make(base, {"damping.beta": 0.001}).id
+    assert RunSpec.make(base, {"damping.beta": 0.001}).id == before
+    rec.write_text("0.0\n0.2\n-0.2\n0.0\n")  # the amplitudes doubled, the same size
+    assert RunSpec.make(base, {"damping.beta": 0.001}).id != before
+    shipped = dict(base, loading={"type": "earthquake", "record": "elcentro-rsn6", "mode": "inertial"})
+    assert "files_sha1" not in RunSpec.make(shipped, {"damping.beta": 0.001}).to_json()
+
+
+@pytest.mark.parametrize("direction", [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+def test_a_study_row_judges_a_block_against_its_angle_about_the_run_axis(direction):
+    """A 0.2 x 1.0 x 2.0 m block released at 0.9 of its instability angle along x (width) or y
+    (length): the row's max_rotation_over_eta is 0.9 both ways (before 2026-11-30 a block specimen
+    was judged against atan(width / height) whatever the direction: 4.2 along y)."""
+    from rockdem.studies import run_spec
+
+    base = example_case("free-rocking")
+    row = run_spec(RunSpec.make(base, {"loading.tilt_direction": direction}, duration=0.05))
+    assert row["max_rotation_over_eta"] == pytest.approx(0.9, rel=1e-3)
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[study]\nbase = "free-rocking"\n[grid]\n"damping.beta" = [0.002, 0.007]\n', r"\['grid'\] outside \[study\].* \[grid\] is \[study.grid\]"),
+    ('duration = 0.3\n[study]\nbase = "free-rocking"\n', r"\['duration'\] outside \[study\]"),
+    ('[study]\nbase = "free-rocking"\n[study.list]\nrows = [{ "damping.beta" = 0.002 }]\nextra = 3\n', r"list: unknown key\(s\) \['extra'\]"),
+])
+def test_a_study_key_outside_its_tables_is_refused(tmp_path, text, message):
+    """Before 2026-11-30 these were ignored: a [grid] beside [study] ran the base case alone."""
+    from rockdem.studies import load_study
+
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        load_study(f)

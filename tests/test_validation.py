@@ -729,3 +729,61 @@ def test_a_load_along_y_is_measured_about_its_own_axis_in_the_python_api():
     assert summarize_result(ds, block="block")["max_rotation_rad"] == pytest.approx(turned, rel=1e-6)
     with pytest.raises(ValueError, match=r"block 'nope' not in the result; give one of \['ground', 'block'\]"):
         summarize_result(ds, block="nope")
+
+
+def test_a_sinking_block_stops_the_run_at_the_same_step_on_a_slow_machine(monkeypatch):
+    """The sinking check runs at fixed simulated times, not after calls whose length follows the
+    machine's speed: the same inputs stop at the same step with the clock running 100 times slower
+    (before 2026-11-30 a block that sank 52 % stopped a run on a slow machine only)."""
+    import rockdem.simulation as sim
+
+    def run():
+        b = ModelBuilder()
+        b.default_material = JointMaterial(kn=1e5, friction_angle=35)
+        b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+        b.add_box(0.2, 1, 1, density=1800, name="block")
+        with pytest.warns(RuntimeWarning, match="sank"):
+            ds = simulate(b.finalize(), 20.0, progress=False)
+        return ds.attrs["diverged_time"], ds.sizes["time"], float(ds.block_position.values[-1, 1, 2])
+
+    fast = run()
+    assert fast[0] < 2.0  # found within the first checks (every 0.5 s here), not at the end
+    clock = sim._time.perf_counter
+    monkeypatch.setattr(sim._time, "perf_counter", lambda: 100.0 * clock())
+    assert run() == fast
+
+
+def test_energy_created_after_dissipation_is_warned_about():
+    """The divergence check compares the mechanical energy with the initial one plus the work, so
+    energy created after friction had taken some passed it without a word; the balance over the
+    recorded frames is now checked (ENERGY_DRIFT_SHARE of the run's scale)."""
+    from rockdem.kernels.layout import E_FRICTION, E_KINETIC, ENERGY_NAMES
+    from rockdem.simulation import _warn_energy_drift
+
+    t = np.linspace(0.0, 1.0, 5)
+    e = np.zeros((5, len(ENERGY_NAMES)))
+    e[:, E_KINETIC] = [100.0, 50.0, 10.0, 40.0, 40.0]  # 90 J to friction, then 30 J from nowhere
+    e[:, E_FRICTION] = [0.0, 50.0, 90.0, 90.0, 90.0]
+    with pytest.warns(RuntimeWarning, match=r"the energy balance is off by \+23.1% of the run.s energy scale \(130 J\) "
+                                            r"at t = 0.75 s: the contacts created 30 J"):
+        _warn_energy_drift(t, e)
+    assert e[3, E_KINETIC] < e[0, E_KINETIC]  # (never above the initial energy: the divergence check's blind spot)
+    e[3:, E_KINETIC] = 12.0  # 2 J created: within 5 %
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _warn_energy_drift(t, e)
+
+
+def test_a_rod_pushover_with_its_own_material_needs_no_default():
+    from rockdem.loading import apply_rod_pushover
+
+    b = ModelBuilder()
+    joint = JointMaterial(kn=1e9, friction_angle=35)
+    b.set_material("ground", "ground", joint)
+    b.set_material("ground", "block", joint)
+    b.set_material("block", "block", joint)
+    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground", group="ground")
+    b.add_box(0.2, 1.0, 1.0, density=1800, name="block", group="block")
+    apply_rod_pushover(b, displacement=0.01, velocity=0.01, material=JointMaterial(kn=1e9, friction_angle=0.0))
+    m = b.finalize(damping=Damping(local=0.8))  # refused before 2026-11-30: no material for 'ground'-'pushover_rod'
+    assert "rod_pushover" in m.block_names
