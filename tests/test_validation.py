@@ -389,17 +389,22 @@ def test_simulate_from_the_package_root_is_the_function():
         simulate(None, 1.0)
 
 
+def _soft_block():
+    """A 0.2 x 1 x 1 m block on joints of kn = 1e5 Pa/m: far too soft for its weight."""
+    b = ModelBuilder()
+    b.default_material = JointMaterial(kn=1e5, friction_angle=35)
+    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_box(0.2, 1, 1, density=1800, name="block")
+    return b.finalize()
+
+
 def test_a_block_sinking_into_far_too_soft_joints_stops_the_run():
     # kn = 1e5 Pa/m under a 1 m tall block: the static overlap rho g h / kn = 0.18 m is most of
     # its 0.2 m thickness. The run stops once an overlap passes a quarter of the thinner block.
     from rockdem.simulation import SINK_FRACTION, simulate
 
-    b = ModelBuilder()
-    b.default_material = JointMaterial(kn=1e5, friction_angle=35)
-    b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
-    b.add_box(0.2, 1, 1, density=1800, name="block")
     with pytest.warns(RuntimeWarning, match="sank"):
-        ds = simulate(b.finalize(), 20.0, progress=False)
+        ds = simulate(_soft_block(), 20.0, progress=False)
     assert ds.attrs["diverged"] == 1 and ds.attrs["diverged_reason"] == "sank" and ds.attrs["diverged_blocks"] == "block"
     assert ds.attrs["diverged_time"] < 20.0 and float(ds.time[-1]) < 20.0  # stopped, keeping the frames computed
     sink = -float(ds.block_position.values[-1, 1, 2] - 0.5)
@@ -738,12 +743,8 @@ def test_a_sinking_block_stops_the_run_at_the_same_step_on_a_slow_machine(monkey
     import rockdem.simulation as sim
 
     def run():
-        b = ModelBuilder()
-        b.default_material = JointMaterial(kn=1e5, friction_angle=35)
-        b.add_box(2, 2, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
-        b.add_box(0.2, 1, 1, density=1800, name="block")
         with pytest.warns(RuntimeWarning, match="sank"):
-            ds = simulate(b.finalize(), 20.0, progress=False)
+            ds = simulate(_soft_block(), 20.0, progress=False)
         return ds.attrs["diverged_time"], ds.sizes["time"], float(ds.block_position.values[-1, 1, 2])
 
     fast = run()
