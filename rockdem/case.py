@@ -12,7 +12,6 @@ import contextlib
 import copy
 import dataclasses
 import difflib
-import importlib.util
 import json
 import math
 import os
@@ -32,6 +31,7 @@ from .geometry import MAX_FACE_POINTS, MAX_LENGTH
 from .materials import JointMaterial, check_material, ks_from_kn
 from .model import SETTLING, Damping, Model, ModelBuilder
 from .records import STANDARD_GRAVITY
+from .results import _has_pyarrow
 from .simulation import Monitor
 from .stopping import REST_WINDOW, STOP_MODES
 from .timestep import DASHPOT_SCHEMES, IMPACT_REFINEMENT
@@ -608,7 +608,7 @@ def _output(top: Table) -> dict[str, Any]:
         "contacts": out_t.string("contacts", "auto", choices=("auto", "csv", "parquet", "none")),
     }
     out_t.finish()
-    if output["contacts"] == "parquet" and importlib.util.find_spec("pyarrow") is None:
+    if output["contacts"] == "parquet" and not _has_pyarrow():
         raise ValueError('[output] contacts = "parquet" needs pyarrow (pip install pyarrow); or give contacts = "csv" '
                          '("auto" writes Parquet when pyarrow is installed, else CSV)')
     return output

@@ -276,11 +276,11 @@ def run_model(
     status = STATUS_DONE
     sunk: tuple[str, str] | None = None
     thickness = block_thickness(model)
-    # Simulated seconds per compiled call, adapted to ~0.25 s of wall time, at most SINK_CHECK_SHARE
+    # Simulated seconds per compiled call, adapted to ~0.25 s of wall time, at most CALL_SHARE
     # of the run. A block sinking into soft joints is found between calls (_sunk), at fixed times
     # (every SINK_CHECK_STEPS starting steps, and at the end): calls end there too, so that the
     # same inputs stop at the same step on any machine and for any duration asked for.
-    longest = max(SINK_CHECK_SHARE * (duration - float(state.time[0])), info.dt)
+    longest = max(CALL_SHARE * (duration - float(state.time[0])), info.dt)
     chunk = min(200 * info.dt, longest)
     sink_every = min(SINK_CHECK_STEPS * info.dt, SINK_CHECK_TIME)
     next_sink = (math.floor(float(state.time[0]) / sink_every) + 1.0) * sink_every
@@ -699,7 +699,7 @@ SINK_FRACTION = 0.25
 the joints are then far too soft for their load (elastic overlaps are normally below 1 %)."""
 
 
-SINK_CHECK_SHARE = 0.05
+CALL_SHARE = 0.05
 """A compiled call of the loop covers at most this share of the run's time."""
 
 SINK_CHECK_TIME = 0.05
