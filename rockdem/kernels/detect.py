@@ -573,6 +573,15 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         sc.prev_pair_normal_force[prev] = 0.0
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
+        if not _has_slots(m, s, fo, b if m.face_block[fo] == a else a) and not (both and _has_slots(m, s, ft, m.face_block[fo])):
+            # Other faces carry the contact now: none of its springs goes on (they are released
+            # below), and the new face's points, found pressed, would start loaded. They start with
+            # no more than the released springs hold now (forces._hand_over_face), as for an EDGE
+            # pair turned FACE; those springs book only their shear energy as they are released.
+            e = _pair_face_energy(m, s, sc, a, b)
+            if e > 0.0:
+                sc.pair_handover[i] = e
+                s.pair_from_edge[i] = True
     s.pair_owner_face[i] = fo
     s.pair_target_face[i] = ft
     ncand = _face_candidates(m, s, sc, fo, ft, ncand, True)
@@ -581,6 +590,16 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         ncand = _face_candidates(m, s, sc, ft, fo, ncand, True)
     s.pair_track_stop[i] = ncand
     return ncand
+
+
+@njit(cache=True, _nrt=False)
+def _has_slots(m: ModelArrays, s: State, f: int, partner: int) -> bool:
+    """Whether a point of face f has a slot for block ``partner``."""
+    for p in range(m.face_point_start[f], m.face_point_start[f + 1]):
+        for k in range(SLOTS):
+            if s.slot_partner[p, k] == partner:
+                return True
+    return False
 
 
 @njit(cache=True, _nrt=False)

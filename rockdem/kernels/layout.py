@@ -209,7 +209,8 @@ class State(NamedTuple):
     pair_normal_force: np.ndarray  # (P,) [N] EDGE: elastic normal force
     pair_overlap: np.ndarray  # (P,) [m] EDGE: overlap at the last force pass, less pair_set
     pair_from_edge: np.ndarray  # (P,) bool FACE: formed at this detection from a pressed EDGE pair of the
-    # same blocks (its sub-contacts continue that contact: none is a landing corner)
+    # same blocks, or from a pressed FACE pair on other faces (its sub-contacts continue that contact: none is
+    # a landing corner)
     pair_set: np.ndarray  # (P,) [m] EDGE: overlap at which the edge spring is unloaded (>= 0; see
     # detect.hand_over_edge: a pair formed overlapping starts with no more energy than it replaces)
     moved: np.ndarray  # (nb,) [m] displacement bound since the last detection
@@ -263,8 +264,9 @@ class Scratch(NamedTuple):
     pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
     pair_asks_detection: np.ndarray  # (P,) bool FACE: its target's points are needed but not tracked (law pass to gather)
-    pair_handover: np.ndarray  # (P,) [J] FACE formed at this detection from an EDGE pair: the normal spring
-    # energy it held (0 unloaded), for the first law pass (forces._hand_over_face); -1 none
+    pair_handover: np.ndarray  # (P,) [J] FACE formed at this detection from an EDGE pair, or from a FACE pair
+    # on other faces: the normal spring energy it held (0 unloaded), for the first law pass
+    # (forces._hand_over_face); -1 none
     # FACE pairs per side (0: the owner's points, 1: the target's), from the law pass to its gather:
     side_force: np.ndarray  # (P, 2, 3) [N] resultant of the side's sub-contact forces on its pressing block
     side_moment: np.ndarray  # (P, 2, 3) [N m] their moment about that block's centroid
