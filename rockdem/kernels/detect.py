@@ -57,7 +57,7 @@ edge-edge contacts. Without the margin a tilting edge flips between the two repr
 An EDGE pair keeps its edge axis without the margin (:func:`separating_axes`, ``was_edge``): with
 it, two random convex blocks whose edges crossed (edge axis 0.49 mm deep, the small face's 0.72)
 turned into a face contact on the 3.4 cm^2 face as they pressed, whose points missed the crossing;
-the 5.6 kg block went on at 2 m/s 2.2 mm deep, the face pair then tracked no point, and it passed
+the 5.6 kg block went on at 1.7 m/s, 2.2 mm deep the face pair tracked no point, and it passed
 through the other (21 mm, the run stopped)."""
 
 
@@ -571,7 +571,7 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         sc.prev_pair_normal_force[prev] = 0.0
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
-        if not _has_slots(m, s, fo, b if m.face_block[fo] == a else a) and not (both and _has_slots(m, s, ft, m.face_block[fo])):
+        if not _has_slots(m, s, fo, m.face_block[ft]) and not (both and _has_slots(m, s, ft, m.face_block[fo])):
             # Other faces carry the contact now: none of its springs goes on (they are released
             # below), and the new face's points, found pressed, would start loaded. They start with
             # no more than the released springs hold now (forces._hand_over_face), as for an EDGE
