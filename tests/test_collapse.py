@@ -656,6 +656,60 @@ def test_a_hull_lands_on_its_deepest_vertex_not_on_its_flattest_face(beta):
     assert float(np.max(np.abs(ds.energy_balance_error_relative.values))) < 0.01
 
 
+PASSING_LOWER = np.array([
+    [0.0261125, -0.0486307, 0.0518472], [0.0859258, -0.0624134, 0.0565379],
+    [0.1446002, -0.0066095, 0.0935872], [0.0004897, -0.0453117, 0.1254278], [0.0908574, 0.003631, 0.0060094],
+    [0.0373895, 0.1079895, 0.1341449], [-0.0001334, 0.0556125, 0.1647731], [0.010258, 0.1082149, 0.1142351],
+    [0.0276568, 0.0043455, 0.167193], [-0.0263002, -0.0150009, 0.0838357],
+    [-0.0033189, -0.0366004, 0.1357389], [0.0291928, 0.107249, 0.1338786],
+    [-0.0078393, -0.019304, 0.0588589], [0.0427366, 0.0606933, 0.0236916], [0.0791779, 0.0726766, 0.1509641],
+    [0.0302545, -0.0629507, 0.0750748], [-0.0186438, 0.0833929, 0.1293544],
+    [-0.0401185, 0.0292096, 0.0999587], [-0.0281344, -0.0177132, 0.1284496],
+])
+PASSING_UPPER = np.array([
+    [-0.0913726, -0.0831682, 0.2656178], [-0.0612756, 0.041421, 0.1962195],
+    [-0.0218979, -0.1240466, 0.1969162], [-0.0534683, 0.0042477, 0.1396987],
+    [-0.0274089, 0.0052425, 0.1414054], [0.0337484, -0.0696154, 0.2178092],
+    [-0.0196503, -0.1105735, 0.2492058], [-0.0798482, 0.0094822, 0.1531927],
+    [-0.1110037, -0.0966468, 0.2136758], [-0.0638122, 0.0288228, 0.2559839],
+    [0.0144003, -0.0355143, 0.2681005], [-0.0210086, -0.0073329, 0.1359511],
+    [-0.0944341, -0.0309705, 0.2766092], [-0.0691693, 0.0390675, 0.2282094],
+    [-0.0718654, 0.0288798, 0.2513342],
+])
+"""Two hulls of a random pile (suite seed 20, 2 m/s) 0.119 s in: the upper one's corner is about to
+slide past the edge of the lower one's 21 cm^2 face."""
+
+
+def test_a_corner_sliding_past_a_faces_edge_is_an_edge_contact():
+    """The upper hull's corner comes down just outside the edge of the lower hull's face: the face
+    axis overlaps more (7.8 mm) than the edge axis of the corner's edges and the face's edge (6.8 mm,
+    27 degrees from the face normal), but until 2026-11-30 an edge axis had to beat a face axis by
+    half the face's overlap (detect.EDGE_AXIS_MARGIN), meant for an edge lying across a face. The
+    face pair's one point, on the corner 0.35 mm outside the face, had no area: the corner went
+    6.8 mm into the lower hull without a force and the run stopped (energy created). The margin now
+    holds only for edge axes within EDGE_MARGIN_ANGLE of the face normal: the crossing is an edge
+    contact from the start."""
+    from rockdem.diagnostics import max_interpenetration
+    from rockdem.geometry import convex_hull
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=9e9, friction_angle=35.0)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_block(convex_hull(PASSING_LOWER, name="lower"), density=2000.0, name="lower",
+                velocity=(0.5094278, 0.7164263, -1.6996501), angular_velocity=(-1.9988632, 17.4532325, -3.0211875))
+    b.add_block(convex_hull(PASSING_UPPER, name="upper"), density=2000.0, name="upper",
+                velocity=(-0.2704385, -0.0667823, -1.8345537), angular_velocity=(7.0456621, -4.7804658, 6.2356402))
+    model = b.finalize(damping=Damping(alpha=1.0, beta=1e-4))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no energy drift warning
+        ds = simulate(model, 0.02, record_interval=0.0002, progress=False)
+    assert "diverged_message" not in ds.attrs
+    assert max_interpenetration(ds).relative < 0.03  # 1.7 % (the edge spring's compliance); before: 6.2 %, stopped
+    assert float(np.max(np.abs(ds.energy_balance_error_relative.values))) < 0.02  # 0.94 %
+
+
 def _random_hull_pile(seed: int, speed: float):
     """Five random convex hulls of 0.12-0.3 m (8-20 points each) stacked 2 cm apart, dropped at
     ``speed`` [m/s] with random spins on a 4 m ground slab (a new user's random pile)."""
