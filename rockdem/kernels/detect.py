@@ -286,20 +286,29 @@ def _incident_face(
     ``tol`` of that face's deepest one. (The face most opposed to n among all need not touch: a
     4 cm^2 face 0.3 degrees from the ground's plane held no point within the tolerance while the
     vertex beside it, on a 47 cm^2 face, landed.)"""
-    r = sc.rotation[blk]
-    deepest = _deepest_vertex(m, sc, blk, nx, ny, nz)
-    lowest = np.inf
-    out = -1
-    for g in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
-        if not _has_corner(m, g, deepest):
-            continue
-        c = _facing(r, m.face_normal[g], nx, ny, nz)
-        if c < lowest:
-            lowest, out = c, g
+    out = _most_opposed(m, sc, blk, nx, ny, nz, _deepest_vertex(m, sc, blk, nx, ny, nz))
+    if out < 0:  # a vertex that is no face's corner (not in a hull rockdem builds): all faces
+        out = _most_opposed(m, sc, blk, nx, ny, nz, -1)
     if previous >= 0 and previous != out:
         low, _ = _face_span(m, sc, out, nx, ny, nz)
         if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and _near_corners_shared(m, sc, out, previous, nx, ny, nz, low + tol):
             return previous
+    return out
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _most_opposed(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, v: int) -> int:
+    """The face of ``blk`` most opposed to the world direction n among those with corner v (all
+    faces for v < 0); -1 if none."""
+    r = sc.rotation[blk]
+    lowest = np.inf
+    out = -1
+    for g in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
+        if v >= 0 and not _has_corner(m, g, v):
+            continue
+        c = _facing(r, m.face_normal[g], nx, ny, nz)
+        if c < lowest:
+            lowest, out = c, g
     return out
 
 
