@@ -710,6 +710,57 @@ def test_a_corner_sliding_past_a_faces_edge_is_an_edge_contact():
     assert float(np.max(np.abs(ds.energy_balance_error_relative.values))) < 0.02  # 0.94 %
 
 
+SINKING_LOWER = np.array([
+    [-0.1079794, -0.0781878, 0.169941], [-0.2301693, -0.0569104, 0.1946573],
+    [-0.0780808, -0.0499411, 0.1529792], [-0.0629372, -0.0847605, 0.0644419],
+    [-0.034659, 0.0003705, 0.0752411], [-0.1081237, 0.028375, 0.1295635], [-0.283614, -0.0765457, 0.170121],
+    [-0.2221126, -0.0596724, 0.0041805], [-0.2450457, -0.1173737, 0.0874983],
+    [-0.0837269, 0.0562076, 0.0532916], [-0.2785994, -0.0675601, 0.176024],
+    [-0.1448113, -0.0823542, 0.1863529],
+])
+SINKING_UPPER = np.array([
+    [-0.1382637, -0.07998, 0.1982376], [0.000464, -0.0414863, 0.1409839],
+    [-0.1064309, -0.0854206, 0.3138591], [0.0059752, 0.1006223, 0.2153046],
+    [-0.0437704, 0.015181, 0.1299482], [-0.1756655, -0.0250985, 0.2848626],
+    [-0.0485946, 0.0944084, 0.1920194], [0.0206713, 0.0670581, 0.1734496],
+    [-0.0860607, -0.1122694, 0.2122792], [-0.1431716, 0.0478949, 0.2201882],
+    [-0.0777675, 0.0371356, 0.1482732], [-0.1288907, 0.0640047, 0.2181587],
+    [-0.1045657, -0.0914872, 0.3054168], [0.0438065, -0.0379001, 0.2151562],
+    [-0.1375323, -0.0860638, 0.2057208],
+])
+"""Two hulls of a random pile (eight hulls of 0.08-0.35 m dropped at 3 m/s, undamped) 0.1955 s in:
+a corner of the upper one is about to sink into a face of the lower one near that face's edge."""
+
+
+def test_a_corners_shear_spring_keeps_its_energy_as_its_cover_grows():
+    """The upper hull's corner sinks 12 mm into the lower hull's face near the face's edge (the
+    penalty's compliance on a corner's cell), so the part of its cell that the face covers grows
+    fivefold under load, the shear spring loaded and not slipping. The normal spring kept its
+    energy as the area grew (forces.cover_change); until 2026-11-30 the shear spring's force
+    ks A u_s grew with the area at the same extension: 3.6 J gained without work, 17 % of the
+    short run's balance. Now its extension is scaled with the area like the overlap."""
+    from rockdem.geometry import convex_hull
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+
+    b = ModelBuilder(points=(2, 2))
+    b.default_material = JointMaterial(kn=9e9, friction_angle=35.0)
+    b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+    b.add_block(convex_hull(SINKING_LOWER, name="lower"), density=2000.0, name="lower",
+                velocity=(0.7379513, -0.7255096, 1.0814563), angular_velocity=(3.0569204, 17.0850736, 6.4786001))
+    b.add_block(convex_hull(SINKING_UPPER, name="upper"), density=2000.0, name="upper",
+                velocity=(-0.5202275, -0.646149, -1.4668378), angular_velocity=(5.3064165, -37.1783771, 0.6295487))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # undamped, on purpose
+        model = b.finalize(damping=Damping())
+        ds = simulate(model, 0.012, record_interval=0.0002, progress=False)
+    assert "diverged_message" not in ds.attrs
+    net = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
+    rise = float(np.max(net - np.minimum.accumulate(net)))
+    assert rise <= 1e-3 * float(ds.energy_kinetic.values[0])  # 0.01 J of 25.5 J; before: 3.6 J
+    assert float(np.max(np.abs(ds.energy_balance_error_relative.values))) < 0.03  # 1.2 %; before: 16.6 %
+
+
 def _random_hull_pile(seed: int, speed: float):
     """Five random convex hulls of 0.12-0.3 m (8-20 points each) stacked 2 cm apart, dropped at
     ``speed`` [m/s] with random spins on a 4 m ground slab (a new user's random pile)."""
