@@ -80,6 +80,24 @@ def _canonical(obj: Any) -> str:
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
 
 
+def _numbers_as_floats(obj: Any) -> Any:
+    """``obj`` (JSON-like) with every int a float (bools kept)."""
+    if isinstance(obj, dict):
+        return {k: _numbers_as_floats(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_numbers_as_floats(v) for v in obj]
+    if isinstance(obj, int) and not isinstance(obj, bool):
+        return float(obj)
+    return obj
+
+
+def _settings_key(spec: RunSpec) -> str:
+    """What makes two runs the same run: their JSON with numbers compared by value, so that a
+    grid's ``[1, 1.0]`` is one run (their ids differ: :attr:`RunSpec.id` hashes the JSON as
+    written, and stored ids must not change)."""
+    return _canonical(_numbers_as_floats(spec.to_json()))
+
+
 def _plain(value: Any) -> Any:
     """NumPy scalars -> Python scalars (so that specs hash and serialise the same way)."""
     if isinstance(value, np.generic):
@@ -518,15 +536,16 @@ def execute(
     if executor == "dask" and scheduler is None:
         raise ValueError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
     workers = _workers(workers)
-    unique: dict[str, RunSpec] = {}
+    by_settings: dict[str, RunSpec] = {}
     for s in specs:
-        unique.setdefault(s.id, s)
+        by_settings.setdefault(_settings_key(s), s)
+    unique = {s.id: s for s in by_settings.values()}
     if len(unique) < len(specs):
         seen: set[str] = set()
         for twice in specs:  # the first run that repeats an earlier one
-            if twice.id in seen:
+            if _settings_key(twice) in seen:
                 break
-            seen.add(twice.id)
+            seen.add(_settings_key(twice))
         warn_user(f"{len(specs) - len(unique)} of the {len(specs)} runs repeat another run's settings and are run once "
                   f"(the first: {_describe(twice)}); a repeated value in a grid, a list or the levels and records of "
                   "an IDA adds no run")
