@@ -91,11 +91,21 @@ def _numbers_as_floats(obj: Any) -> Any:
     return obj
 
 
-def _settings_key(spec: RunSpec) -> str:
-    """What makes two runs the same run: their JSON with numbers compared by value, so that a
-    grid's ``[1, 1.0]`` is one run (their ids differ: :attr:`RunSpec.id` hashes the JSON as
-    written, and stored ids must not change)."""
-    return _canonical(_numbers_as_floats(spec.to_json()))
+def _warn_respelled(specs: Sequence[RunSpec]) -> None:
+    """Warn where two runs' settings differ only in how a number is written (a grid's ``[1, 1.0]``):
+    their ids differ (:attr:`RunSpec.id` hashes the JSON as written, and stored ids must not
+    change), and an integer setting may refuse the float, so both run."""
+    first: dict[str, RunSpec] = {}
+    twins = []
+    for spec in specs:
+        twin = first.setdefault(_canonical(_numbers_as_floats(spec.to_json())), spec)
+        if twin is not spec:
+            twins.append((twin, spec))
+    if twins:
+        a, b = twins[0]
+        warn_user(f"{len(twins)} run(s) repeat another run's settings with a number written differently, and run as "
+                  f"separate runs (the first: {_describe(b)} beside {_describe(a)}); write each value of a grid, a list "
+                  "or an IDA once")
 
 
 def _plain(value: Any) -> Any:
@@ -536,19 +546,19 @@ def execute(
     if executor == "dask" and scheduler is None:
         raise ValueError("the dask executor needs a scheduler address (--scheduler tcp://HOST:PORT)")
     workers = _workers(workers)
-    by_settings: dict[str, RunSpec] = {}
+    unique: dict[str, RunSpec] = {}
     for s in specs:
-        by_settings.setdefault(_settings_key(s), s)
-    unique = {s.id: s for s in by_settings.values()}
+        unique.setdefault(s.id, s)
     if len(unique) < len(specs):
         seen: set[str] = set()
         for twice in specs:  # the first run that repeats an earlier one
-            if _settings_key(twice) in seen:
+            if twice.id in seen:
                 break
-            seen.add(_settings_key(twice))
+            seen.add(twice.id)
         warn_user(f"{len(specs) - len(unique)} of the {len(specs)} runs repeat another run's settings and are run once "
                   f"(the first: {_describe(twice)}); a repeated value in a grid, a list or the levels and records of "
                   "an IDA adds no run")
+    _warn_respelled(list(unique.values()))
     st = Store(store) if store is not None and not isinstance(store, Store) else store
     stored = {r["id"]: r for r in st.rows()} if st is not None else {}
     done = {i for i, r in stored.items() if r.get("status") in FINISHED}
