@@ -96,7 +96,7 @@ def _warn_respelled(specs: Sequence[RunSpec]) -> None:
     their ids differ (:attr:`RunSpec.id` hashes the JSON as written, and stored ids must not
     change), and an integer setting may refuse the float, so both run."""
     first: dict[str, RunSpec] = {}
-    twins = []
+    twins: list[tuple[RunSpec, RunSpec]] = []
     for spec in specs:
         twin = first.setdefault(_canonical(_numbers_as_floats(spec.to_json())), spec)
         if twin is not spec:
