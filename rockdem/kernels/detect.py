@@ -219,9 +219,9 @@ def _supporting_edge(m: ModelArrays, sc: Scratch, blk: int, i: int, nx: float, n
 
 INCIDENT_KEEP = 0.1
 """The incident face of the last detection is kept while its deepest vertex (along the reference
-normal) is within this many tracking tolerances of the deepest vertex of the most opposed face,
-and every corner of the most opposed face within the tracking tolerance of that face's deepest is
-a corner of the kept face too (:func:`_incident_face`): a block rocking on the edge between two of
+normal) is within this many tracking tolerances of the deepest vertex of the face the rule would
+choose now, and every corner of that face near the reference face (below the level of
+:func:`_incident_face`) is a corner of the kept face too: a block rocking on the edge between two of
 its faces (both reach the same depth) keeps the face carrying its sub-contacts (each switch
 re-represents a loaded contact), while a face landing flat takes over as soon as it reaches deeper,
 or as soon as a corner the kept face lacks comes within the tolerance (it is about to press: it
@@ -278,21 +278,89 @@ def _face_span(m: ModelArrays, sc: Scratch, f: int, nx: float, ny: float, nz: fl
 
 @njit(cache=True, _nrt=False)
 def _incident_face(
-    m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, previous: int, tol: float
+    m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, previous: int, tol: float, plane: float
 ) -> int:
-    """Of the faces of ``blk`` at its deepest vertex along the world direction -n, the one most
-    opposed to n; or ``previous`` (a face of blk, or -1) while it reaches as deep along -n as that
-    face, within INCIDENT_KEEP tolerances ``tol``, and has every corner of that face that lies within
-    ``tol`` of that face's deepest one. (The face most opposed to n among all need not touch: a
-    4 cm^2 face 0.3 degrees from the ground's plane held no point within the tolerance while the
-    vertex beside it, on a 47 cm^2 face, landed.)"""
-    out = _most_opposed(m, sc, blk, nx, ny, nz, _deepest_vertex(m, sc, blk, nx, ny, nz))
+    """The incident face of ``blk`` against a reference face whose plane lies at ``plane`` [m]
+    along the world direction n (n points from the reference face towards blk). Of the faces of blk
+    at its deepest vertex along -n, the one with the largest part *near* the reference face, below
+    ``level = max(deepest, plane) + tol`` along n (pressing, or about to; the most opposed to n
+    among those with as large a part, :func:`_widest_face`); or ``previous`` (a face of blk, or -1)
+    while it reaches as deep along -n as that face, within INCIDENT_KEEP tolerances ``tol``, and
+    has every corner of that face below ``level``. So a block landing on a vertex, rocking on an
+    edge or landing flat is carried by the face most nearly parallel to the reference face (the
+    longest strip near an edge, the whole face), and a small facet at a vertex (a chipped corner, a
+    hull's sliver) carries the contact only while no face beside it comes nearer the reference
+    over a larger area: a box's edge landing whose end was chipped off by a 3.5 mm^2 facet, the
+    most opposed face at the deepest vertex, pressed on that facet's points alone and sank 52 mm,
+    half the box, before 2026-12-01. (Nor need the face most opposed to n among all touch: a 4 cm^2
+    face 0.3 degrees from the ground's plane held no point within the tolerance while the vertex
+    beside it, on a 47 cm^2 face, landed.)"""
+    v = _deepest_vertex(m, sc, blk, nx, ny, nz)
+    deepest = nx * sc.world_vertex[v, 0] + ny * sc.world_vertex[v, 1] + nz * sc.world_vertex[v, 2]
+    level = max(deepest, plane) + tol
+    out = _widest_face(m, sc, blk, nx, ny, nz, v, level)
     if out < 0:  # a vertex that is no face's corner (not in a hull rockdem builds): all faces
         out = _most_opposed(m, sc, blk, nx, ny, nz, -1)
     if previous >= 0 and previous != out:
         low, _ = _face_span(m, sc, out, nx, ny, nz)
-        if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and _near_corners_shared(m, sc, out, previous, nx, ny, nz, low + tol):
+        if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and _near_corners_shared(m, sc, out, previous, nx, ny, nz, level):
             return previous
+    return out
+
+
+@njit(cache=True, _nrt=False)
+def _submerged_area(m: ModelArrays, sc: Scratch, g: int, nx: float, ny: float, nz: float, level: float) -> float:
+    """Area [m^2] of the part of face g below ``level`` along the world direction n [m] (world
+    vertices current): the face polygon clipped by that plane, in its own coordinates."""
+    c0 = m.face_corner_start[g]
+    nc = m.face_corner_start[g + 1] - c0
+    wv = sc.world_vertex
+    cross = 0.0
+    fu = fw = pu = pw = 0.0
+    started = False
+    for k in range(nc):
+        a = m.face_corner[c0 + k]
+        b = m.face_corner[c0 + (k + 1) % nc]
+        ha = nx * wv[a, 0] + ny * wv[a, 1] + nz * wv[a, 2] - level
+        hb = nx * wv[b, 0] + ny * wv[b, 1] + nz * wv[b, 2] - level
+        for out in range(2):  # the corner a if below, then the crossing of edge a-b if any
+            if out == 0:
+                if ha >= 0.0:
+                    continue
+                qu, qw = m.face_corner_uw[c0 + k, 0], m.face_corner_uw[c0 + k, 1]
+            else:
+                if (ha < 0.0) == (hb < 0.0):
+                    continue
+                r = ha / (ha - hb)
+                j = (k + 1) % nc
+                qu = m.face_corner_uw[c0 + k, 0] + r * (m.face_corner_uw[c0 + j, 0] - m.face_corner_uw[c0 + k, 0])
+                qw = m.face_corner_uw[c0 + k, 1] + r * (m.face_corner_uw[c0 + j, 1] - m.face_corner_uw[c0 + k, 1])
+            if started:
+                cross += pu * qw - qu * pw
+            else:
+                fu, fw, started = qu, qw, True
+            pu, pw = qu, qw
+    if started:
+        cross += pu * fw - fu * pw
+    return 0.5 * abs(cross)
+
+
+@njit(cache=True, _nrt=False)
+def _widest_face(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, v: int, level: float) -> int:
+    """Of the faces of ``blk`` with corner v (global id), the one with the largest part below
+    ``level`` along the world direction n [m] (:func:`_submerged_area`; world vertices current); of
+    those with as large a part, the most opposed to n. -1 if v is no face's corner."""
+    r = sc.rotation[blk]
+    best = -1.0
+    lowest = np.inf
+    out = -1
+    for g in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
+        if not _has_corner(m, g, v):
+            continue
+        area = _submerged_area(m, sc, g, nx, ny, nz, level)
+        c = _facing(r, m.face_normal[g], nx, ny, nz)
+        if area > best or (area == best and c < lowest):
+            best, lowest, out = area, c, g
     return out
 
 
@@ -472,6 +540,35 @@ def _prev_edge_energy_now(m: ModelArrays, s: State, sc: Scratch, k: int, kn: flo
 
 
 @njit(cache=True, _nrt=False)
+def _pair_touching(m: ModelArrays, s: State, a: int, b: int) -> tuple[bool, bool]:
+    """Whether a face sub-contact between blocks a and b is in contact (covered at its last law
+    pass and compressed, or held at a set, ``s.slot_set``: an overlap taken as its new zero,
+    unloaded), and whether one is bonded."""
+    touching = False
+    bonded = False
+    for side in range(2):
+        blk, oth = (a, b) if side == 0 else (b, a)
+        for p in range(m.face_point_start[m.block_face_start[blk]], m.face_point_start[m.block_face_start[blk + 1]]):
+            for k in range(SLOTS):
+                if s.slot_partner[p, k] == oth:
+                    covered = s.slot_area[p, k] > 0.0  # (an uncovered slot keeps its set, unused)
+                    touching = touching or (covered and (s.slot_set[p, k] > 0.0 or s.slot_normal_force[p, k] > 0.0))
+                    bonded = bonded or s.slot_bonded[p, k]
+    return touching, bonded
+
+
+@njit(cache=True, _nrt=False)
+def _release_face_slots(m: ModelArrays, s: State, a: int, b: int) -> None:
+    """Release every face sub-contact slot between blocks a and b (:func:`release_slot`)."""
+    for side in range(2):
+        blk, oth = (a, b) if side == 0 else (b, a)
+        for p in range(m.face_point_start[m.block_face_start[blk]], m.face_point_start[m.block_face_start[blk + 1]]):
+            for k in range(SLOTS):
+                if s.slot_partner[p, k] == oth:
+                    release_slot(m, s, p, k)
+
+
+@njit(cache=True, _nrt=False)
 def _pair_face_energy(m: ModelArrays, s: State, sc: Scratch, a: int, b: int) -> float:
     """Elastic energy [J] that the compressed normal springs of the face sub-contacts between
     blocks a and b would hold at the present pose (rotations current), which is taken from them
@@ -613,15 +710,25 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         sc.prev_pair_normal_force[prev] = 0.0
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
-        if not _has_slots(m, s, fo, m.face_block[ft]) and not (both and _has_slots(m, s, ft, m.face_block[fo])):
-            # Other faces carry the contact now: none of its springs goes on (they are released
-            # below), and the new face's points, found pressed, would start loaded. They start with
-            # no more than the released springs hold now (forces._hand_over_face), as for an EDGE
-            # pair turned FACE; those springs book only their shear energy as they are released.
-            e = _pair_face_energy(m, s, sc, a, b)
-            if e > 0.0:
-                sc.pair_handover[i] = e
+        po, pt = sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]
+        changed = not ((fo == po and ft == pt) or (fo == pt and ft == po))
+        fresh = not _has_slots(m, s, fo, m.face_block[ft]) and not (both and _has_slots(m, s, ft, m.face_block[fo]))
+        if changed or fresh:
+            # Other faces carry the contact now, or none of its springs goes on: the new faces'
+            # points, found pressed, would start loaded. The new springs start with no more than
+            # the pair's springs hold now (forces._hand_over_face), as for an EDGE pair turned
+            # FACE: those springs are released with only their shear energy booked, the ones a
+            # new face keeps too (they restart, so that what a kept spring held is not booked
+            # twice, by the hand-over and by its cover's change); a pair held at its sets,
+            # unloaded, hands over nothing, and its new springs start unloaded at their depths.
+            # A pair with a bonded slot whose faces change keeps its slots and is not handed over
+            # (its new points start loaded, as before 2026-12-01), unless none of them has a slot.
+            touching, bonded = _pair_touching(m, s, a, b)
+            if touching and (fresh or not bonded):
+                sc.pair_handover[i] = _pair_face_energy(m, s, sc, a, b)
                 s.pair_from_edge[i] = True
+                if not fresh:
+                    _release_face_slots(m, s, a, b)
     s.pair_owner_face[i] = fo
     s.pair_target_face[i] = ft
     s.pair_track_split[i] = split  # (the candidates were added above)
@@ -671,7 +778,9 @@ def _face_roles(
     won the separating axes along the world normal n against block ``oth``; ``keep``: oth's face
     of the same pair at the last detection (-1 none), kept as incident face while it reaches as
     deep (:func:`_incident_face`)."""
-    iface = _incident_face(m, sc, oth, nx, ny, nz, keep, m.contact_tol)
+    c0 = m.face_corner[m.face_corner_start[rface]]  # the reference face's plane along n
+    plane = nx * sc.world_vertex[c0, 0] + ny * sc.world_vertex[c0, 1] + nz * sc.world_vertex[c0, 2]
+    iface = _incident_face(m, sc, oth, nx, ny, nz, keep, m.contact_tol, plane)
     ar = m.face_area[rface]
     ai = m.face_area[iface]
     # The smaller face owns the points (tie: the lower block id).

@@ -354,9 +354,10 @@ def _hand_over_face(m: ModelArrays, s: State, sc: Scratch, i: int, a: int, b: in
     started loaded: a frictionless cube sliding over a foundation's edge gained 0.25 J in one step
     (its sub-contacts 0.1-0.27 mm deep under the edge). A pair whose slots carry history (not new
     at this detection) books the budget as dissipated, as before. A FACE pair whose faces changed
-    at this detection while none of its springs went on (detect._narrow) is handed over alike: a
-    random hull pressed 2.8 mm into another changed its carrying faces, and the new face's five
-    points started loaded with 52 J where the released ones held 6 J."""
+    at this detection under load, or none of whose springs went on, is handed over alike, every
+    slot of it new (detect._narrow releases those a face kept): a random hull pressed 2.8 mm into
+    another changed its carrying faces, and the new face's five points started loaded with 52 J
+    where the released ones held 6 J."""
     kn = m.mat_kn[m.block_group[a], m.block_group[b]]
     held = 0.0
     for k in range(s.pair_track_start[i], s.pair_track_stop[i]):
