@@ -300,7 +300,7 @@ def _incident_face(
     level = max(deepest, plane) + tol
     out = _widest_face(m, sc, blk, nx, ny, nz, v, level)
     if out < 0:  # a vertex that is no face's corner (not in a hull rockdem builds): all faces
-        out = _most_opposed(m, sc, blk, nx, ny, nz, -1)
+        out = _most_opposed(m, sc, blk, nx, ny, nz)
     if previous >= 0 and previous != out:
         low, _ = _face_span(m, sc, out, nx, ny, nz)
         if _face_span(m, sc, previous, nx, ny, nz)[0] <= low + INCIDENT_KEEP * tol and _near_corners_shared(m, sc, out, previous, nx, ny, nz, level):
@@ -311,7 +311,9 @@ def _incident_face(
 @njit(cache=True, _nrt=False)
 def _submerged_area(m: ModelArrays, sc: Scratch, g: int, nx: float, ny: float, nz: float, level: float) -> float:
     """Area [m^2] of the part of face g below ``level`` along the world direction n [m] (world
-    vertices current): the face polygon clipped by that plane, in its own coordinates."""
+    vertices current): the face polygon clipped by that plane, in its own coordinates. (Clipped
+    and summed as it goes, not in the scratch's polygon buffer of :mod:`.polygon`: a face may
+    have more corners than that buffer, sized for cells, holds.)"""
     c0 = m.face_corner_start[g]
     nc = m.face_corner_start[g + 1] - c0
     wv = sc.world_vertex
@@ -365,15 +367,12 @@ def _widest_face(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def _most_opposed(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float, v: int) -> int:
-    """The face of ``blk`` most opposed to the world direction n among those with corner v (all
-    faces for v < 0); -1 if none."""
+def _most_opposed(m: ModelArrays, sc: Scratch, blk: int, nx: float, ny: float, nz: float) -> int:
+    """The face of ``blk`` most opposed to the world direction n."""
     r = sc.rotation[blk]
     lowest = np.inf
     out = -1
     for g in range(m.block_face_start[blk], m.block_face_start[blk + 1]):
-        if v >= 0 and not _has_corner(m, g, v):
-            continue
         c = _facing(r, m.face_normal[g], nx, ny, nz)
         if c < lowest:
             lowest, out = c, g
