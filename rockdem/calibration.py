@@ -19,6 +19,7 @@ import argparse
 import json
 import math
 import os
+import signal
 import sys
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -427,7 +428,7 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
 
 
 def _calibrate_cli(args: argparse.Namespace) -> int:
-    from .cli import output_folder, stop_on_signals
+    from .cli import hold_signals, output_folder, stop_on_signals
 
     ref = load_reference(args.reference, quantity=args.quantity)
     fixed = dict(parse_assignment(item) for item in args.set or [])
@@ -436,24 +437,33 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
                          "positive bounds; add --linear for a parameter that may be 0")
     out = output_folder(args.out, "--out", create=False) if args.out else None
     store = Store(out) if out is not None else None  # finished runs kept: a rerun resumes
+    received: list[int] = []
     try:
-        with stop_on_signals():  # SIGTERM and SIGHUP stop it as Ctrl-C does
+        with stop_on_signals(received):  # SIGTERM and SIGHUP stop it as Ctrl-C does
             res = calibrate(args.base, args.parameter, args.bounds, ref, fixed=fixed, duration=args.duration,
                             log=not args.linear, scan_points=args.scan, executor=args.executor or "process",
                             workers=args.workers, scheduler=args.scheduler, stop=args.stop, store=store)
+        if out is not None:  # the files first: a closed standard output must not lose them
+            # A stop signal here is held until every file is written (a second one abandons them):
+            # before 2026-12-01 a Ctrl-C while they were written left evaluations.csv and curve.csv
+            # without report.txt.
+            with hold_signals(received, "writing the calibration's files"):
+                out.mkdir(parents=True, exist_ok=True)
+                res.evaluations.to_csv(out / "evaluations.csv", index=False)
+                if res.curve is not None:
+                    res.curve.to_csv(out / "curve.csv", index=False)
+                    plot_calibration(res, ref, out / "wme.png")
+                (out / "calibration.json").write_text(json.dumps(res.to_json(), indent=2))
+                (out / "report.txt").write_text(res.report() + "\n")
     except KeyboardInterrupt:
         print(f"rockdem calibrate: stopped; {store.kept() if store is not None else 'give --out to keep finished runs'}",
               file=sys.stderr)
         raise
-    if out is not None:  # the files first: a closed standard output must not lose them
-        out.mkdir(parents=True, exist_ok=True)
-        res.evaluations.to_csv(out / "evaluations.csv", index=False)
-        if res.curve is not None:
-            res.curve.to_csv(out / "curve.csv", index=False)
-            plot_calibration(res, ref, out / "wme.png")
-        (out / "calibration.json").write_text(json.dumps(res.to_json(), indent=2))
-        (out / "report.txt").write_text(res.report() + "\n")
     print(res.report())
+    if received:  # held while the files were written (or come as the calibration ended): they are complete
+        print(f"rockdem calibrate: {signal.Signals(received[-1]).name} came as the calibration ended; its files are "
+              "complete", file=sys.stderr)
+        return 128 + received[-1]
     return 1 if res.failed else 0  # as a sweep with failed runs
 
 
@@ -461,7 +471,9 @@ def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable
     """Add ``calibrate``."""
     p = subparsers.add_parser("calibrate", help="find a parameter minimising WME against a reference history",
                               epilog="Exit status: 0 done; 1 some runs failed (counted in the report's notes; WME 1000 "
-                              "taken there); 2 bad input, or every run failed (nothing to compare).")
+                              "taken there); 2 bad input, or every run failed (nothing to compare); 128+N stopped by "
+                              "signal N (130 Ctrl-C): the finished runs kept in --out, a rerun resumes; a signal while "
+                              "the files are written is held until they are complete (a second one abandons them).")
     p.add_argument("reference", help="reference: CSV (time, value) or a rockdem result .nc")
     p.add_argument("--base", default="free-rocking", help="base case: example name or TOML path")
     p.add_argument("--parameter", default="damping.beta", help="table.key to calibrate (damping.alpha, specimen.kn, ...)")

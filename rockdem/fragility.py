@@ -40,7 +40,7 @@ from .loading import earthquake_record
 from .plots import save_figure
 from .records import STANDARD_GRAVITY
 from .stopping import STOP_MODES
-from .studies import RunSpec, Store, execute, resolve_base, save_table, study_table, with_stop
+from .studies import RunSpec, Store, execute, read_with_care, resolve_base, save_table, study_table, with_stop
 
 __all__ = [
     "Fragility",
@@ -387,6 +387,8 @@ def run_ida(base: str | Mapping[str, Any], records: Sequence[str], pga_g: Sequen
     t_p = period if period is not None else characteristic_period(specs)
     df = add_intensities(df, specs, t_p)
     save_table(df, out)
+    for note in read_with_care(df):
+        warn_user(note)
     done = df[completed(df)]
     if done.empty:
         first = df["error"].dropna().iloc[0] if "error" in df and df["error"].notna().any() else "no error message"

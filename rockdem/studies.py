@@ -57,6 +57,7 @@ __all__ = [
     "with_stop",
     "Study",
     "load_study",
+    "read_with_care",
     "run_study",
     "resolve_base",
     "TIMING_COLUMNS",
@@ -871,7 +872,41 @@ def run_study(study: Study, out: str | os.PathLike[str], *, executor: str | None
             scheduler=scheduler or study.scheduler, progress=progress)
     df = study_table(store, specs=study.specs)
     save_table(df, Path(out))
+    for note in read_with_care(df):
+        warn_user(note)
     return df
+
+
+def read_with_care(df: pd.DataFrame) -> list[str]:
+    """Notes on the rows of a study table whose figures to read with care (the runs' own warnings
+    are silenced inside a study): runs whose contacts created energy beyond
+    :data:`rockdem.simulation.ENERGY_DRIFT_SHARE` of their energy scale (the warning a single run
+    gives), and free-rocking runs whose mean apparent restitution ``e_a_mean`` exceeds 1 (the
+    rocking grew between impacts, which no restitution model gives: Eq. 6 then reads no loss).
+    One note per kind, naming the worst run; an empty list when none."""
+    from .simulation import ENERGY_DRIFT_SHARE
+
+    notes = []
+    if {"energy_created_J", "energy_scale_J"} <= set(df.columns):
+        share = df["energy_created_J"] / df["energy_scale_J"].where(df["energy_scale_J"] > 0.0)
+        bad = share[share > ENERGY_DRIFT_SHARE]
+        if len(bad):
+            k = bad.idxmax()
+            notes.append(f"{len(bad)} of {len(df)} runs created energy beyond {ENERGY_DRIFT_SHARE:.0%} of their energy scale "
+                         f"(the most: run {df.at[k, 'id']}, {df.at[k, 'energy_created_J']:.3g} J, {bad[k]:.1%}; column "
+                         "energy_created_J): fast impacts on small faces, blocks passing through one another; read those "
+                         "rows with care (docs/contacts.md section 5)")
+    if "e_a_mean" in df.columns:
+        ea = pd.to_numeric(df["e_a_mean"], errors="coerce")
+        above = ea[ea > 1.0]
+        if len(above):
+            k = above.idxmax()
+            notes.append(f"{len(above)} of {len(df)} runs read a mean apparent restitution e_a_mean above 1 (the largest: "
+                         f"run {df.at[k, 'id']}, {above[k]:.4f}): their rocking grew between impacts, so Eq. 6 reads no "
+                         "loss there. Without damping the joints' elastic vibration, started by the release and the "
+                         "impacts, feeds the rocking back (see energy_created_J for energy the engine created); "
+                         "damp the joints (rockdem advise) before comparing e_a")
+    return notes
 
 
 # --------------------------------------------------------------------------------------------------

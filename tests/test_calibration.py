@@ -139,3 +139,31 @@ def test_a_flat_reference_and_a_duration_short_of_its_motion_are_refused_before_
     moving = Reference(np.linspace(0.0, 4.0, 401), 0.1 * np.exp(-0.5 * np.linspace(0.0, 4.0, 401)) * np.cos(np.linspace(0.0, 40.0, 401)))
     with pytest.raises(ValueError, match=r"duration = 1 s ends before the reference's motion does \(3.\d+ s\).*--duration"):
         calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), moving, duration=1.0, executor="serial")
+
+
+def test_a_stop_signal_while_the_files_are_written_is_held_until_they_are_complete(synthetic, tmp_path, monkeypatch, capsys) -> None:
+    """Ctrl-C as ``rockdem calibrate`` writes its files (here: as it draws wme.png, the third of
+    five) is held until report.txt is written, then ends the command with 130 (before 2026-12-01
+    it left evaluations.csv and curve.csv without calibration.json and report.txt)."""
+    import os
+    import signal
+
+    from rockdem.cli import main
+
+    draw = cal.plot_calibration
+
+    def interrupted_draw(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)
+        return draw(*args, **kwargs)
+
+    monkeypatch.setattr(cal, "plot_calibration", interrupted_draw)
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time,rotation\n" + "".join(f"{t:.3f},{v:.6f}\n" for t, v in zip(REF.time, REF.value)))
+    out = tmp_path / "cal"
+    assert main(["calibrate", str(ref), "--bounds", "2e-4", "5e-3", "--scan", "9", "--executor", "serial", "--out", str(out)]) == 130
+    assert sorted(p.name for p in out.iterdir() if p.suffix != ".jsonl") == [
+        "calibration.json", "curve.csv", "evaluations.csv", "report.txt", "wme.png"]
+    assert "WME" in (out / "report.txt").read_text()
+    err = capsys.readouterr().err
+    assert "rockdem: writing the calibration's files; interrupt again to abandon" in err
+    assert "SIGINT came as the calibration ended; its files are complete" in err

@@ -481,3 +481,25 @@ def test_a_study_key_outside_its_tables_is_refused(tmp_path, text, message):
     f.write_text(text)
     with pytest.raises(ValueError, match=message):
         load_study(f)
+
+
+def test_a_study_names_its_rows_to_read_with_care():
+    """A study silences its runs' own warnings, so its table's rows whose contacts created energy
+    beyond the single run's warning share, or whose mean apparent restitution exceeds 1 (rocking
+    that grew between impacts: undamped slender blocks read 1.0018 and 1.0019 on 2026-12-01), are
+    named in one note per kind, the worst run first; rows within both, or without the columns (a
+    study of failed runs), give none."""
+    from rockdem.simulation import ENERGY_DRIFT_SHARE
+    from rockdem.studies import read_with_care
+
+    df = pd.DataFrame({"id": ["a", "b", "c", "d"], "e_a_mean": [0.93, 1.0018, None, 1.0041],
+                       "energy_created_J": [0.0, 0.2, 6.0, 0.049 * 100.0],
+                       "energy_scale_J": [70.0, 70.0, 100.0, 100.0]})
+    notes = read_with_care(df)
+    assert len(notes) == 2
+    assert notes[0].startswith(f"1 of 4 runs created energy beyond {ENERGY_DRIFT_SHARE:.0%} of their energy scale "
+                               "(the most: run c, 6 J, 6.0%")
+    assert notes[1].startswith("2 of 4 runs read a mean apparent restitution e_a_mean above 1 (the largest: run d, 1.0041)")
+    assert read_with_care(df.assign(e_a_mean=[0.93, 1.0, None, 0.99], energy_created_J=0.0)) == []
+    assert read_with_care(pd.DataFrame({"id": ["a"], "status": ["error"], "error": ["ValueError: ..."]})) == []
+    assert read_with_care(df.assign(energy_scale_J=0.0, e_a_mean=None)) == []
