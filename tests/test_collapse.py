@@ -9,6 +9,7 @@ initial energy plus the work done by more than 1 % of the energy scale.
 import dataclasses
 import importlib.util
 import sys
+import tempfile
 import warnings
 from pathlib import Path
 
@@ -918,8 +919,35 @@ def test_a_face_pair_held_at_its_sets_hands_nothing_over_when_its_faces_change()
     set, unloaded (handed over before), when its faces change at 0.1252 s. The new face's points
     found at that depth started loaded (6.2 J at once, with the incident face of 2026-12-01) while
     the old springs held nothing to hand over: a pair held at its sets now hands over nothing, and
-    its new springs start unloaded at their depths (detect._pair_touching)."""
+    its new springs start unloaded at their depths (detect._pair_touching). The event is checked
+    to happen (the pile is chaotic: a change elsewhere may move it, and then this test must be
+    given another)."""
+    from rockdem.checkpoint import load_checkpoint
+    from rockdem.kernels.layout import PAIR_FACE, SLOTS
+    from rockdem.simulation import run_model
+
     model = _random_hull_pile(33, 4.0)
+    h1, h3 = model.block_id("h1"), model.block_id("h3")
+
+    def face_pair(t: float, tmp: str):
+        """The FACE pair of h1 and h3 at time t: (owner face, target face, sets [m], normal forces [N])."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out = run_model(model, t, record_interval=0.0002, progress=False, checkpoint=tmp)
+        st = load_checkpoint(out.attrs["checkpoint"]).state
+        for i in range(st.pair_count[0]):
+            if (st.pair_a[i], st.pair_b[i]) == (h1, h3) and st.pair_kind[i] == PAIR_FACE:
+                slots = [divmod(int(st.track[k]), SLOTS) for k in range(st.pair_track_start[i], st.pair_track_stop[i])]
+                return (int(st.pair_owner_face[i]), int(st.pair_target_face[i]), np.array([st.slot_set[p, j] for p, j in slots]),
+                        np.array([st.slot_normal_force[p, j] for p, j in slots]))
+        raise AssertionError(f"no FACE pair of h1 and h3 at {t} s")
+
+    with tempfile.TemporaryDirectory() as tmp:
+        before = face_pair(0.1252, f"{tmp}/a.npz")
+        after = face_pair(0.1254, f"{tmp}/b.npz")
+    assert before[2].max() > 2e-3 and not before[3].any()  # held 2.4 mm deep at its set, unloaded
+    assert before[:2] != after[:2]  # its faces change
+    assert after[2].max() > 2e-3  # the new springs start at their depths (sets), not loaded from them
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = simulate(model, 0.13, record_interval=0.0002, progress=False)
