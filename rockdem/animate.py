@@ -31,7 +31,7 @@ from matplotlib import colormaps, rc_context
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .cli import integer_at_least, output_file, positive_float, positive_int
+from .cli import dots_per_inch, integer_at_least, output_file, positive_float, positive_int
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices, rotation_vector
 from .plots import STYLE, Result, load_result, read_result_file, rocking_direction
 
@@ -459,5 +459,5 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--max-frames", type=positive_int, default=300,
                    help=f"most frames (default 300): beyond, the rate drops to {MIN_FPS:g} fps, then the playback speeds up (said)")
     p.add_argument("--size", type=_frame_size, nargs=2, default=(640, 480), metavar=("W", "H"), help="pixels (default 640 480)")
-    p.add_argument("--dpi", type=positive_float, default=100.0, help="pixels per inch of the text (default 100)")
+    p.add_argument("--dpi", type=dots_per_inch, default=100.0, help="pixels per inch of the text (default 100)")
     p.set_defaults(func=_animate)

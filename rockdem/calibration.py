@@ -191,6 +191,8 @@ class CalibrationResult:
         notes: caveats (a better point outside the bounds, a curve not centred on its minimum, runs
             that failed).
         failed: how many evaluated runs failed (their WME is FAILED_WME; ``evaluations.error``).
+        flat: the WME did not depend on the parameters over the bounds (:data:`FLAT_WME`): the
+            optimum is only the first point tried, nothing was calibrated (a note says so).
 
     The optimum is the best point evaluated within the bounds (scan, search and curve alike): the
     WME curve is re-centred on any better point it finds, so its 0 % row is the optimum.
@@ -204,6 +206,7 @@ class CalibrationResult:
     sensitivity: dict[str, float] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     failed: int = 0
+    flat: bool = False
 
     def report(self) -> str:
         """Plain-text report."""
@@ -221,7 +224,7 @@ class CalibrationResult:
 
     def to_json(self) -> dict[str, Any]:
         return {"parameters": self.parameters, "optimum": self.optimum, "wme": self.wme, "sensitivity": self.sensitivity,
-                "notes": self.notes, "failed": self.failed}
+                "notes": self.notes, "failed": self.failed, "flat": self.flat}
 
 
 def calibrate(
@@ -391,12 +394,22 @@ def calibrate(
         result.failed = len(failed)
         result.notes.append(f"{len(failed)} of {len(evals)} runs failed (WME {FAILED_WME:g} taken there; the error column of "
                             f"the evaluations), e.g. at {', '.join(f'{k} = {failed[0][k]:.6g}' for k in keys)}: {failed[0]['error']}")
-    outside = [e for e in evals if not inside(e) and e["wme"] < result.wme]
+    ok = [e["wme"] for e in evals if e["error"] is None]
+    margin = FLAT_WME * max(ok, default=0.0)  # differences below it are no improvement
+    if len(ok) >= 3 and max(ok) - min(ok) <= margin:
+        note = (f"the WME does not depend on {', '.join(keys)} over the bounds: all {len(ok)} runs gave {min(ok):.4g}, "
+                "so the optimum reported is only the first point tried; the runs' history does not see the parameter "
+                "there (a reference too short for it, or another quantity): nothing was calibrated")
+        result.notes.append(note)
+        result.flat = True
+        warn_user(f"calibration: {note}")
+        return result  # (the notes below would compare equal values)
+    outside = [e for e in evals if not inside(e) and e["wme"] < result.wme - margin]
     if outside:
         e = min(outside, key=lambda e: e["wme"])
         result.notes.append(f"a point outside the bounds did better: {', '.join(f'{k} = {e[k]:.6g}' for k in keys)} "
                             f"(WME {e['wme']:.4g}); widen the bounds")
-    if result.curve is not None and float(result.curve["wme"].min()) < result.wme:
+    if result.curve is not None and float(result.curve["wme"].min()) < result.wme - margin:
         result.notes.append("the curve around the optimum is not centred on its minimum "
                             f"(after {MAX_RECENTRES} re-centrings); the WME surface is rough here")
     return result
@@ -425,6 +438,13 @@ def plot_calibration(result: CalibrationResult, reference: Reference, path: str 
     p = save_figure(fig, path)
     plt.close(fig)
     return p
+
+
+FLAT_WME = 1e-6
+"""Relative spread of the evaluated WME below which the surface is flat: the parameter does not
+act on the runs' history (before 2026-12-01 a calibration against a reference of two samples 0.2 s
+apart, WME 4.322 at every point to 3e-7, reported the lower bound as its optimum and its surface
+as rough)."""
 
 
 def _calibrate_cli(args: argparse.Namespace) -> int:
@@ -464,14 +484,14 @@ def _calibrate_cli(args: argparse.Namespace) -> int:
         print(f"rockdem calibrate: {signal.Signals(received[-1]).name} came as the calibration ended; its files are "
               "complete", file=sys.stderr)
         return 128 + received[-1]
-    return 1 if res.failed else 0  # as a sweep with failed runs
+    return 1 if res.failed or res.flat else 0  # as a sweep with failed runs
 
 
 def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """Add ``calibrate``."""
     p = subparsers.add_parser("calibrate", help="find a parameter minimising WME against a reference history",
                               epilog="Exit status: 0 done; 1 some runs failed (counted in the report's notes; WME 1000 "
-                              "taken there); 2 bad input, or every run failed (nothing to compare); 128+N stopped by "
+                              "taken there), or the WME does not depend on the parameter (nothing calibrated); 2 bad input, or every run failed (nothing to compare); 128+N stopped by "
                               "signal N (130 Ctrl-C): the finished runs kept in --out, a rerun resumes; a signal while "
                               "the files are written is held until they are complete (a second one abandons them).")
     p.add_argument("reference", help="reference: CSV (time, value) or a rockdem result .nc")

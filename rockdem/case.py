@@ -70,8 +70,23 @@ MAX_DEPTH = 16
 
 PLAUSIBLE: dict[str, tuple[float, float, str]] = {
     "pga_g": (5.0, 50.0, "the largest peak ground acceleration ever recorded is about 4 g"),
+    "gravity": (30.0, 5000.0, "gravity is in m/s^2, 9.81 on the Earth (tens of g only on a centrifuge; 9810 is mm/s^2)"),
 }
 """Keys with a plausible range: (warn above, refuse above, why)."""
+BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
+    (b"\x89HDF\r\n\x1a\n", "a NetCDF-4 file (a result, result.nc)"),
+    (b"CDF\x01", "a NetCDF file (a result, result.nc)"),
+    (b"CDF\x02", "a NetCDF file (a result, result.nc)"),
+    (b"PK\x03\x04", "a zip archive (a checkpoint, checkpoint.npz)"),
+    (b"\x89PNG", "a PNG image"),
+    (b"%PDF", "a PDF document"),
+)
+"""Leading bytes of the files rockdem writes (and of images) that a user may give where a case is
+read: named, not reported as text that is not UTF-8 (before 2026-12-01)."""
+BINARY_HINT = ("give the case's TOML file (to continue a run: rockdem run CASE.toml --from OUT/checkpoint.npz; "
+               "a result is read by rockdem plot and rockdem export)")
+GRAVITY_LOW = 1.62
+"""[specimen] gravity [m/s^2] below which (but above 0) a case is warned about: the Moon's."""
 
 
 class Table:
@@ -441,6 +456,9 @@ def read_toml(path: str | os.PathLike[str], what: str = "case file") -> dict[str
         raw = fh.read(MAX_FILE_BYTES + 1)
     if len(raw) > MAX_FILE_BYTES:
         raise ValueError(f"{what} {p} is larger than {MAX_FILE_BYTES // 1024**2} MiB; a TOML case or study file is a few kB")
+    for magic, kind in BINARY_KINDS:
+        if raw.startswith(magic):
+            raise ValueError(f"{what} {p} is {kind}, not a TOML case or study file; {BINARY_HINT}")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -578,6 +596,9 @@ def _specimen(top: Table) -> tuple[ModelBuilder, dict[str, Monitor]]:
     spec_t = top.sub("specimen")
     kind = spec_t.string("type", choices=tuple(sorted(SPECIMENS)))
     grav = spec_t.number("gravity", 9.81, min_=0.0)
+    if 0.0 < grav < GRAVITY_LOW:
+        warn_user(f"[specimen] gravity = {grav:g} m/s^2 is below the Moon's {GRAVITY_LOW} m/s^2: gravity is in m/s^2 "
+                  "(9.81 on the Earth, not 1 for 1 g); check the value and its units")
     builder = ModelBuilder(gravity=(0.0, 0.0, -grav))
     monitors = SPECIMENS[kind](spec_t, builder)
     spec_t.finish()

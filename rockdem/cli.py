@@ -139,6 +139,22 @@ def _number(kind: str) -> Callable[[str], float]:
     return parse
 
 
+MAX_DPI = 1200.0
+"""Largest figure resolution [dots per inch] rockdem draws (print quality is 300 to 600; at 1e5 a
+plot ran out of memory in Matplotlib's renderer, 2026-12-01)."""
+
+
+def dots_per_inch(text: str) -> float:
+    """An argparse type: a resolution [dots per inch] in (0, :data:`MAX_DPI`]."""
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not (0.0 < v <= MAX_DPI):
+        raise argparse.ArgumentTypeError(f"must be a resolution in (0, {MAX_DPI:g}] dots per inch, got {text!r}")
+    return v
+
+
 def integer_at_least(low: int) -> Callable[[str], int]:
     """An argparse type: an integer >= ``low``."""
 

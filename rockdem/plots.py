@@ -43,6 +43,7 @@ from .analysis import (
     wme,
 )
 from .kernels.rotation import axis_angle_matrix, quats_to_matrices
+from .cli import dots_per_inch, positive_float
 from .style import STYLE, InlineFigure, save_figure
 
 __all__ = [
@@ -269,7 +270,9 @@ def plot_history(
     b = _block(ds, block)
     t = ds.time.values
     u, src = top_displacement(ds, monitor)
-    bw = float(length) if length else block_dimensions(ds, b)[0]
+    if length is not None and not float(length) > 0.0:
+        raise ValueError(f"length = {length!r}: the normalising length B must be positive [m] (None: the block's width)")
+    bw = float(length) if length is not None else block_dimensions(ds, b)[0]
     quake = ground_acceleration(ds)
     fig = InlineFigure(figsize=(_WIDTH, 4.6 if quake is None else 8.2))
     axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
@@ -536,7 +539,9 @@ def _quantity(ds: xr.Dataset, quantity: str, monitor: str | None, length: float 
         return ds.rocking_angle.values[:, _block(ds, None)]
     if quantity == "displacement":
         u, _ = top_displacement(ds, monitor)
-        return u / (float(length) if length else block_dimensions(ds, None)[0])
+        if length is not None and not float(length) > 0.0:
+            raise ValueError(f"length = {length!r}: the normalising length B must be positive [m] (None: the block's width)")
+        return u / (float(length) if length is not None else block_dimensions(ds, None)[0])
     raise ValueError(f"quantity must be 'displacement' (u/B) or 'rotation' [rad], got {quantity!r}")
 
 
@@ -677,10 +682,10 @@ def register_cli(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--kind", default="history", choices=sorted(PLOTS) + ["all"], help="what to plot (default history)")
     p.add_argument("-o", "--output", help="output .png or .pdf (default RESULT_KIND.png next to the result)")
     p.add_argument("--format", default="png", choices=("png", "pdf"), help="format when -o is not given")
-    p.add_argument("--dpi", type=float, default=None, help="resolution [dots per inch] (default 100)")
+    p.add_argument("--dpi", type=dots_per_inch, default=None, help="resolution [dots per inch] (default 100)")
     p.add_argument("--block", help="block name or id (default: the lowest free block)")
     p.add_argument("--monitor", help="monitor for the top displacement (default: the first recorded)")
-    p.add_argument("--length", type=float, help="normalising length B [m] for u/B (default: the block width)")
+    p.add_argument("--length", type=positive_float, help="normalising length B [m] for u/B (default: the block width)")
     p.add_argument("--measured", help="CSV of a measured history (time [s], value) for --kind comparison")
     p.add_argument("--quantity", default="displacement", choices=("displacement", "rotation"))
     p.add_argument("--labels", nargs="+", help="legend labels, one per result")

@@ -72,8 +72,10 @@ def _show(args: argparse.Namespace) -> int:
 
     if (args.case is None) == (args.example is None):
         raise ValueError("give a case file (rockdem show CASE.toml) or --example NAME")
-    data = example_case(args.example) if args.example else load_case(args.case)
-    case = parse_case(apply_overrides(data, args.set or []))
+    data = apply_overrides(example_case(args.example) if args.example else load_case(args.case), args.set or [])
+    if isinstance(data.get("run", {}), dict) and "duration" not in data.get("run", {}):
+        data = apply_overrides(data, ["run.duration=1.0"])  # a preview runs nothing: a case without one is shown
+    case = parse_case(data)
     out = output_file(args.output if args.output else f"{case.name}_preview.png", "-o")
     p = save_figure(preview(case.model, case.monitors, title=case.name), out)
     print(repr(case.model))

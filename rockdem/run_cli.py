@@ -102,6 +102,16 @@ def run_case(
         warn_user(f"the run ends at {options['duration']:g} s ([run] duration or --duration), before the record's peak "
                   f"ground acceleration (at {float(peak):.3g} s of the run): the specimen does not feel the strong "
                   "motion; lengthen the run")
+    a = case.attrs
+    if "pushover_rate" in a:  # load control: the ramp ends at max_load_factor / rate
+        end, what = float(a["pushover_max_load_factor"]) / float(a["pushover_rate"]), "its max_load_factor"
+    elif "pushover_rod_velocity" in a:  # the rod at full speed until displacement / velocity (its speed ramps down after)
+        end, what = float(a["pushover_displacement"]) / float(a["pushover_rod_velocity"]), "the end of its push"
+    else:
+        end = None
+    if end is not None and options["duration"] < end * (1.0 - 1e-9):
+        warn_user(f"the run ends at {options['duration']:g} s ([run] duration or --duration), before the pushover reaches "
+                  f"{what} (at {end:.4g} s): the capacity curve stops short of it; lengthen the run")
     ds = simulate(case.model, **options, progress=progress, initial=initial, checkpoint=checkpoint,
                   checkpoint_every=checkpoint_every, threads=threads)
     with _deferred_signals(finishing=True):  # the frames are computed: a stop signal waits for the result
@@ -347,6 +357,10 @@ def _run(args: argparse.Namespace) -> int:
     data = apply_overrides(data, args.set or [])
     if args.stop is not None:
         data = apply_overrides(data, [f'run.stop="{args.stop}"'])
+    if args.duration is not None and "duration" not in (data.get("run") or {}):
+        # --duration stands for a [run] duration the case leaves out (before 2026-12-01 such a case
+        # was refused, "[run] duration is required", whatever --duration said)
+        data = apply_overrides(data, [f"run.duration={args.duration!r}"])
     t0 = time.perf_counter()
     case = parse_case(data)
     initial = None
@@ -357,6 +371,7 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out or case.output["directory"] or Path("results") / case.name)
     files = ("result.nc", "histories.csv", "rocking.png", "checkpoint.npz", "contacts.csv", "contacts.parquet")
     output_folder(out, "--out" if args.out else "[output] directory" if case.output["directory"] else "output folder", files)
+    earlier = [f for f in files if (out / f).exists()]  # an earlier run's outputs (named below if not rewritten)
     save_ck = case.output["checkpoint"] and not args.no_checkpoint
     every = args.checkpoint_every if args.checkpoint_every is not None else case.output["checkpoint_every"]
     if every is not None and not save_ck:
@@ -372,25 +387,34 @@ def _run(args: argparse.Namespace) -> int:
                           checkpoint=out / "checkpoint.npz" if save_ck else None, checkpoint_every=every,
                           threads=args.threads)
         wall = time.perf_counter() - t0
-        with hold_signals(received, "saving the results computed so far"):
-            series = rocking_series(ds) if plot else None
-            if plotter is not None:
-                plotter.submit(series, out / "rocking.png")
-            written = [save(ds, out / "result.nc")]
-            if case.output["csv"]:
-                written.append(export_csv(ds, out / "histories.csv"))
-            if "contact_time" in ds.coords and case.output["contacts"] != "none":
-                written.append(write_contact_table(ds, out / "contacts", case.output["contacts"]))
-            if plotter is not None:
-                written.append(plotter.draw(series, out / "rocking.png"))
-            if "checkpoint" in ds.attrs:
-                written.append(Path(ds.attrs["checkpoint"]))
+        written: list[Path] = []
+        try:
+            with hold_signals(received, "saving the results computed so far"):
+                series = rocking_series(ds) if plot else None
+                if plotter is not None:
+                    plotter.submit(series, out / "rocking.png")
+                written.append(save(ds, out / "result.nc"))
+                if case.output["csv"]:
+                    written.append(export_csv(ds, out / "histories.csv"))
+                if "contact_time" in ds.coords and case.output["contacts"] != "none":
+                    written.append(write_contact_table(ds, out / "contacts", case.output["contacts"]))
+                if plotter is not None:
+                    written.append(plotter.draw(series, out / "rocking.png"))
+                if "checkpoint" in ds.attrs:
+                    written.append(Path(ds.attrs["checkpoint"]))
+        except KeyboardInterrupt:  # a second stop signal abandoned the save: say what the folder holds
+            print(f"rockdem run: the save was abandoned; written: {', '.join(p.name for p in written) or 'nothing'}"
+                  + _stale_note(out, earlier, written), file=sys.stderr)
+            raise
     print(f"rockdem run: {case.name}")
     for line in summary_lines(ds):
         print("  " + line)
     print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
         print("  " + _row("wrote", "", "", str(p)))
+    stale = _stale_note(out, earlier, written)
+    if stale:
+        print(f"rockdem run: warning: {stale.lstrip('; ')}", file=sys.stderr)
     if ds.attrs.get("interrupted"):  # stopped before the end: the frames computed so far are saved
         if "checkpoint" in ds.attrs:
             print(f"  continue with: {continue_command(args, ds.attrs['checkpoint'])}")
@@ -399,6 +423,19 @@ def _run(args: argparse.Namespace) -> int:
         print(f"rockdem run: {signal.Signals(received[0]).name} came after the run had ended; the result is complete",
               file=sys.stderr)
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
+
+
+def _stale_note(out: Path, earlier: list[str], written: list[Path]) -> str:
+    """"; FOLDER also holds ... of an earlier run" for the output files ``earlier`` (names) that
+    were in ``out`` before this run and that it did not write; "" when none (before 2026-12-01 a
+    reused folder kept an earlier run's rocking.png, contacts.csv or checkpoint.npz beside the new
+    result without a word)."""
+    names = {Path(p).name for p in written}
+    left = [f for f in earlier if f not in names and (out / f).exists()]
+    if not left:
+        return ""
+    return (f"; {out} also holds {', '.join(left)} of an earlier run, not written by this one (remove them, "
+            "or give another --out)")
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:

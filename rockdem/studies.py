@@ -958,6 +958,7 @@ def _sweep(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path(args.study).with_suffix("")
     check_first_run(study.specs)
     output_folder(out, "--out", create=False)
+    kept = len({spec.id for spec in study.specs} & Store(out).done_ids())  # finished by an earlier call: not run again
     t0 = time.perf_counter()
     try:
         with stop_on_signals():  # SIGTERM and SIGHUP stop the sweep and its workers as Ctrl-C does
@@ -968,7 +969,8 @@ def _sweep(args: argparse.Namespace) -> int:
         raise
     n_err = int((df["status"] == "error").sum()) if "status" in df else 0
     n_div = int((df["status"] == "diverged").sum()) if "status" in df else 0
-    print(f"{len(df)} runs ({n_err} failed, {n_div} diverged) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
+    again = f", {kept} of them kept from an earlier call" if kept else ""  # (a resumed study ran only the rest)
+    print(f"{len(df)} runs ({n_err} failed, {n_div} diverged{again}) in {time.perf_counter() - t0:.1f} s -> {out / 'table.csv'}")
     if n_err:
         failed = df[df["status"] == "error"]
         for _, row in failed.head(FAILED_SHOWN).iterrows():

@@ -45,9 +45,13 @@ class InlineFigure(Figure):
 
 def save_figure(fig: Figure, path: str | Path, *, dpi: float | None = None) -> Path:
     """Write a figure as PNG or PDF (by suffix) with the fixed style; returns the path."""
+    from .cli import MAX_DPI
+
     p = Path(path)
     if p.suffix.lower() not in (".png", ".pdf"):
         raise ValueError(f"output {p}: the suffix must be .png or .pdf")
+    if dpi is not None and not (0.0 < float(dpi) <= MAX_DPI):
+        raise ValueError(f"dpi = {dpi!r}: give a resolution in (0, {MAX_DPI:g}] dots per inch (or None, the default 100)")
     p.parent.mkdir(parents=True, exist_ok=True)
     with rc_context(STYLE):
         fig.savefig(p, dpi=dpi or STYLE["savefig.dpi"], metadata={"Software": None} if p.suffix == ".png" else None)

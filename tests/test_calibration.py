@@ -167,3 +167,24 @@ def test_a_stop_signal_while_the_files_are_written_is_held_until_they_are_comple
     err = capsys.readouterr().err
     assert "rockdem: writing the calibration's files; interrupt again to abandon" in err
     assert "SIGINT came as the calibration ended; its files are complete" in err
+
+
+def test_a_wme_that_does_not_depend_on_the_parameter_calibrates_nothing(synthetic, monkeypatch, tmp_path, capsys) -> None:
+    """A WME the parameter does not move (a reference of two samples 0.2 s apart: 4.322 at every
+    point to 3e-7, measured 2026-12-01) is reported as such, with a warning and exit status 1,
+    and none of the notes that compare equal values (a better point outside the bounds, a rough
+    surface) that it gave before."""
+    from rockdem.cli import main
+
+    monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: 4.322 * (1.0 + 3e-7 * np.sin(1e4 * r["beta"])))
+    with pytest.warns(UserWarning, match="the WME does not depend on damping.beta over the bounds"):
+        res = calibrate("free-rocking", "damping.beta", (1e-3, 1e-2), REF, scan_points=9, executor="serial")
+    assert res.flat and len(res.notes) == 1 and "nothing was calibrated" in res.notes[0]
+    ref = tmp_path / "ref.csv"
+    ref.write_text("time,rotation\n" + "".join(f"{t:.3f},{v:.6f}\n" for t, v in zip(REF.time, REF.value)))
+    assert main(["calibrate", str(ref), "--bounds", "1e-3", "1e-2", "--scan", "9", "--executor", "serial"]) == 1
+    captured = capsys.readouterr()
+    assert "note: the WME does not depend on damping.beta" in captured.out
+    assert "warning: calibration: the WME does not depend on damping.beta" in captured.err
+    monkeypatch.setattr(cal, "wme_of_row", lambda r, ref: _surface(r["beta"]))
+    assert not calibrate("free-rocking", "damping.beta", (2e-4, 5e-3), REF, scan_points=9, executor="serial").flat

@@ -1,6 +1,8 @@
 """The command line as a user runs it: the built-in example end to end, and bad input."""
 
+import re
 import sys
+import warnings
 
 import numpy as np
 import pytest
@@ -175,6 +177,7 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
         assert (out / "result.nc").exists() == saved
         if not saved:
             assert "stopped by SIGINT" in err
+            assert "the save was abandoned; written: nothing" in err
         else:
             assert "SIGINT came after the run had ended; the result is complete" in err
 
@@ -396,6 +399,11 @@ def test_every_command_checks_its_output_path_and_input_files(tmp_path, capsys):
     (["animate", "r.nc", "--size", "100000", "480"], "at most 4096 pixels"),
     (["animate", "r.nc", "--view", "nan,nan"], "--view"),
     (["run"], "give a case file (rockdem run CASE.toml) or --example NAME (rockdem run --list-examples)"),
+    (["plot", "r.nc", "--dpi", "100000"], "--dpi: must be a resolution in (0, 1200] dots per inch"),  # a MemoryError before
+    (["plot", "r.nc", "--dpi", "0"], "--dpi: must be a resolution in (0, 1200] dots per inch"),  # the default before
+    (["animate", "r.nc", "--dpi", "1e5"], "--dpi: must be a resolution in (0, 1200] dots per inch"),
+    (["plot", "r.nc", "--length", "-1"], "--length: must be a positive number"),  # u/B with B = -1 m before
+    (["run", "--example", "free-rocking", "--set", "specimen.gravity=9810"], "gravity = 9810 is not plausible"),
 ])
 def test_implausible_command_line_values_are_refused(argv, message, capsys):
     assert main(argv) == 2
@@ -540,3 +548,63 @@ def test_a_closed_standard_output_ends_the_command_quietly(monkeypatch, capsys):
     monkeypatch.setattr(sys, "stdout", Closed())
     assert main(["records"]) == 141
     assert "standard output closed by its reader" in capsys.readouterr().err
+
+
+def test_a_reused_output_folder_names_what_an_earlier_run_left_there(tmp_path, capsys):
+    """A run into a folder of an earlier one that wrote more (a plot, a contact table, a
+    checkpoint) names those files (before 2026-12-01 they stayed beside the new result without a
+    word); files the new run rewrites are not named."""
+    out = tmp_path / "o"
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.05", "--quiet", "--no-plot",
+                 "--set", "run.contact_interval=0.01"]) == 0
+    capsys.readouterr()
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.02", "--quiet", "--no-plot",
+                 "--no-checkpoint"]) == 0
+    err = capsys.readouterr().err
+    assert f"{out} also holds checkpoint.npz, contacts.csv of an earlier run, not written by this one" in err
+    assert main(["run", "--example", "free-rocking", "--out", str(tmp_path / "new"), "--duration", "0.02", "--quiet",
+                 "--no-plot"]) == 0
+    assert "of an earlier run" not in capsys.readouterr().err
+
+
+def test_duration_on_the_command_line_stands_for_a_missing_one(tmp_path, capsys):
+    """--duration overrides [run] duration, and stands for it where the case leaves it out (such a
+    case was refused, "[run] duration is required", before 2026-12-01); rockdem show runs nothing
+    and needs none."""
+    case = tmp_path / "c.toml"
+    case.write_text('[specimen]\ntype = "block"\nwidth = 0.3\nheight = 1.2\nyoungs_modulus = 1e9\n'
+                    '[damping]\nbeta = 0.001\n[loading]\ntype = "free-rocking"\ntilt_fraction = 0.5\n')
+    assert main(["run", str(case), "--out", str(tmp_path / "o"), "--duration", "0.1", "--no-plot", "--quiet"]) == 0
+    assert float(load(tmp_path / "o" / "result.nc").time.values[-1]) == pytest.approx(0.1)
+    assert main(["run", str(case), "--out", str(tmp_path / "o2"), "--quiet"]) == 2
+    assert "[run] duration is required" in capsys.readouterr().err
+    assert main(["show", str(case), "-o", str(tmp_path / "p.png")]) == 0
+    assert (tmp_path / "p.png").exists()
+
+
+def test_a_result_checkpoint_or_image_given_as_a_case_is_named(tmp_path, capsys):
+    """A result, a checkpoint or a plot given where a case file is read is named for what it is,
+    with the command that reads it (it was "not UTF-8 text" before 2026-12-01)."""
+    out = tmp_path / "o"
+    assert main(["run", "--example", "free-rocking", "--out", str(out), "--duration", "0.02", "--quiet"]) == 0
+    capsys.readouterr()
+    for name, kind in (("result.nc", "a NetCDF-4 file (a result, result.nc)"),
+                       ("checkpoint.npz", "a zip archive (a checkpoint, checkpoint.npz)"), ("rocking.png", "a PNG image")):
+        for argv in (["run", str(out / name), "--quiet"], ["show", str(out / name)]):
+            assert main(argv) == 2
+            err = capsys.readouterr().err
+            assert f"{out / name} is {kind}, not a TOML case or study file" in err and "--from OUT/checkpoint.npz" in err
+
+
+def test_gravity_in_other_units_is_warned_about(tmp_path):
+    """[specimen] gravity is in m/s^2: 9810 (mm/s^2) is refused (above), 50 (a centrifuge's 5 g, or
+    a mistake) and 1 (meant as 1 g) are warned about; 9.81 and 0 (a model without weight) are not."""
+    from rockdem.case import example_case, parse_case
+
+    data = example_case("free-rocking")
+    for g, message in ((50.0, "gravity = 50.0 is above 30"), (1.0, "gravity = 1 m/s^2 is below the Moon's 1.62 m/s^2")):
+        with pytest.warns(UserWarning, match=re.escape(message)):
+            parse_case({**data, "specimen": {**data["specimen"], "gravity": g}})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        parse_case({**data, "specimen": {**data["specimen"], "gravity": 9.81}})

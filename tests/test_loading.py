@@ -7,6 +7,7 @@ and by statics of a block on an elastic Winkler base of discrete springs (sub-co
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -391,3 +392,15 @@ def test_a_record_ending_at_rest_is_applied_as_it_is():
     assert gm.displacement()[-1] == pytest.approx(amp * tp**2 / (2 * np.pi), rel=1e-3)
     offset = prepare_record(GroundMotion.from_samples(acc + 0.01, dt=dt, units="m/s2", name="offset"))
     assert abs(offset.velocity()[-1]) < 1e-9 and not np.allclose(offset.acceleration[: t.size], acc + 0.01)
+
+
+def test_a_pushover_cut_short_by_its_duration_is_warned_about():
+    """A pushover whose run ends before its load reaches max_load_factor (load control), or before
+    the rod's push ends (displacement control), says so, as an earthquake run ended before the
+    record's peak does (before 2026-12-01 only the summary's applied factor showed it)."""
+    for name, end in (("pushover_0.2x2.0_points2", "its max_load_factor (at 4.75 s)"),
+                      ("pushover_rod_0.2x2.0_points10", "the end of its push (at 10 s)")):
+        case = parse_case(load_case(EXAMPLES / f"{name}.toml"))
+        with pytest.warns(UserWarning, match=re.escape(f"the run ends at 0.02 s ([run] duration or --duration), before the "
+                                                       f"pushover reaches {end}")):
+            run_case(case, duration=0.02, progress=False)

@@ -170,7 +170,7 @@ def test_interrupted_sweep_resumes_without_recomputing(base, tmp_path):
     assert len([ln for ln in store.path.read_text().splitlines() if ln.strip()]) == n
 
 
-def test_study_file_and_cli(tmp_path):
+def test_study_file_and_cli(tmp_path, capsys):
     from rockdem.cli import main
 
     f = tmp_path / "s.toml"
@@ -190,8 +190,11 @@ def test_study_file_and_cli(tmp_path):
     assert main(["sweep", str(f), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
     df = pd.read_csv(tmp_path / "out" / "table.csv")
     assert len(df) == 4 and set(df["damping.alpha"]) == {2.0, 4.0}
+    assert "4 runs (0 failed, 0 diverged) in" in capsys.readouterr().out
     assert main(["sweep", str(f), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
     assert len((tmp_path / "out" / "runs.jsonl").read_text().splitlines()) == 4
+    # a resumed sweep says what it ran itself (before 2026-12-01 it printed the same line)
+    assert "4 runs (0 failed, 0 diverged, 4 of them kept from an earlier call) in" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("tables,where", [
