@@ -403,8 +403,9 @@ def _run(args: argparse.Namespace) -> int:
                 if "checkpoint" in ds.attrs:
                     written.append(Path(ds.attrs["checkpoint"]))
         except KeyboardInterrupt:  # a second stop signal abandoned the save: say what the folder holds
+            left = _left_over(out, earlier, written)
             print(f"rockdem run: the save was abandoned; written: {', '.join(p.name for p in written) or 'nothing'}"
-                  + _stale_note(out, earlier, written), file=sys.stderr)
+                  + (f"; {out} also holds {', '.join(left)} of an earlier run" if left else ""), file=sys.stderr)
             raise
     print(f"rockdem run: {case.name}")
     for line in summary_lines(ds):
@@ -412,9 +413,10 @@ def _run(args: argparse.Namespace) -> int:
     print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
         print("  " + _row("wrote", "", "", str(p)))
-    stale = _stale_note(out, earlier, written)
-    if stale:
-        print(f"rockdem run: warning: {stale.lstrip('; ')}", file=sys.stderr)
+    left = _left_over(out, earlier, written)
+    if left:  # (before 2026-12-01 they stayed beside the new result without a word)
+        print(f"rockdem run: warning: {out} also holds {', '.join(left)} of an earlier run, not written by this one "
+              "(remove them, or give another --out)", file=sys.stderr)
     if ds.attrs.get("interrupted"):  # stopped before the end: the frames computed so far are saved
         if "checkpoint" in ds.attrs:
             print(f"  continue with: {continue_command(args, ds.attrs['checkpoint'])}")
@@ -425,17 +427,11 @@ def _run(args: argparse.Namespace) -> int:
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
 
 
-def _stale_note(out: Path, earlier: list[str], written: list[Path]) -> str:
-    """"; FOLDER also holds ... of an earlier run" for the output files ``earlier`` (names) that
-    were in ``out`` before this run and that it did not write; "" when none (before 2026-12-01 a
-    reused folder kept an earlier run's rocking.png, contacts.csv or checkpoint.npz beside the new
-    result without a word)."""
+def _left_over(out: Path, earlier: list[str], written: list[Path]) -> list[str]:
+    """The output files ``earlier`` (names) that were in ``out`` before this run and that it did
+    not write (still there)."""
     names = {Path(p).name for p in written}
-    left = [f for f in earlier if f not in names and (out / f).exists()]
-    if not left:
-        return ""
-    return (f"; {out} also holds {', '.join(left)} of an earlier run, not written by this one (remove them, "
-            "or give another --out)")
+    return [f for f in earlier if f not in names and (out / f).exists()]
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:
