@@ -491,9 +491,10 @@ def register_cli(subparsers: argparse._SubParsersAction, add_exec_args: Callable
     """Add ``calibrate``."""
     p = subparsers.add_parser("calibrate", help="find a parameter minimising WME against a reference history",
                               epilog="Exit status: 0 done; 1 some runs failed (counted in the report's notes; WME 1000 "
-                              "taken there), or the WME does not depend on the parameter (nothing calibrated); 2 bad input, or every run failed (nothing to compare); 128+N stopped by "
-                              "signal N (130 Ctrl-C): the finished runs kept in --out, a rerun resumes; a signal while "
-                              "the files are written is held until they are complete (a second one abandons them).")
+                              "taken there), or the WME does not depend on the parameter (nothing calibrated); 2 bad "
+                              "input, or every run failed (nothing to compare); 128+N stopped by signal N (130 Ctrl-C): "
+                              "the finished runs kept in --out, a rerun resumes; a signal while the files are written "
+                              "is held until they are complete (a second one abandons them).")
     p.add_argument("reference", help="reference: CSV (time, value) or a rockdem result .nc")
     p.add_argument("--base", default="free-rocking", help="base case: example name or TOML path")
     p.add_argument("--parameter", default="damping.beta", help="table.key to calibrate (damping.alpha, specimen.kn, ...)")
