@@ -192,7 +192,7 @@ class CalibrationResult:
             that failed).
         failed: how many evaluated runs failed (their WME is FAILED_WME; ``evaluations.error``).
         flat: the WME did not depend on the parameters over the bounds (:data:`FLAT_WME`): the
-            optimum is only the first point tried, nothing was calibrated (a note says so).
+            optimum is an arbitrary point, nothing was calibrated (a note says so).
 
     The optimum is the best point evaluated within the bounds (scan, search and curve alike): the
     WME curve is re-centred on any better point it finds, so its 0 % row is the optimum.
@@ -398,7 +398,7 @@ def calibrate(
     margin = FLAT_WME * max(ok, default=0.0)  # differences below it are no improvement
     if len(ok) >= 3 and max(ok) - min(ok) <= margin:
         note = (f"the WME does not depend on {', '.join(keys)} over the bounds: all {len(ok)} runs gave {min(ok):.4g}, "
-                "so the optimum reported is only the first point tried; the runs' history does not see the parameter "
+                "to 1e-6, so the optimum reported is an arbitrary point; the runs' history does not see the parameter "
                 "there (a reference too short for it, or another quantity): nothing was calibrated")
         result.notes.append(note)
         result.flat = True

@@ -78,13 +78,16 @@ BINARY_KINDS: tuple[tuple[bytes, str], ...] = (
     (b"CDF\x01", "a NetCDF file (a result, result.nc)"),
     (b"CDF\x02", "a NetCDF file (a result, result.nc)"),
     (b"PK\x03\x04", "a zip archive (a checkpoint, checkpoint.npz)"),
+    (b"PAR1", "a Parquet table (a contact or study table)"),
     (b"\x89PNG", "a PNG image"),
     (b"%PDF", "a PDF document"),
+    (b"GIF8", "a GIF animation"),
+    (b"ftyp", "an MP4 video"),  # (at offset 4)
 )
-"""Leading bytes of the files rockdem writes (and of images) that a user may give where a case is
-read: named, not reported as text that is not UTF-8 (before 2026-12-01)."""
-BINARY_HINT = ("give the case's TOML file (to continue a run: rockdem run CASE.toml --from OUT/checkpoint.npz; "
-               "a result is read by rockdem plot and rockdem export)")
+"""Leading bytes of the files rockdem writes (and of images) that a user may give where a case or
+study file is read: named, not reported as text that is not UTF-8 (before 2026-12-01)."""
+BINARY_HINT = ("give the TOML file (to continue a run: rockdem run CASE.toml --from OUT/checkpoint.npz; a result "
+               "is read by rockdem plot and rockdem export)")
 GRAVITY_LOW = 1.62
 """[specimen] gravity [m/s^2] below which (but above 0) a case is warned about: the Moon's."""
 
@@ -454,11 +457,11 @@ def read_toml(path: str | os.PathLike[str], what: str = "case file") -> dict[str
         raise ValueError(f"{what} {p} is {kind}; give a TOML file")
     with p.open("rb") as fh:
         raw = fh.read(MAX_FILE_BYTES + 1)
+    for magic, kind in BINARY_KINDS:
+        if raw.startswith(magic) or (magic == b"ftyp" and raw[4:8] == magic):
+            raise ValueError(f"{what} {p} is {kind}, not a TOML case or study file; {BINARY_HINT}")
     if len(raw) > MAX_FILE_BYTES:
         raise ValueError(f"{what} {p} is larger than {MAX_FILE_BYTES // 1024**2} MiB; a TOML case or study file is a few kB")
-    for magic, kind in BINARY_KINDS:
-        if raw.startswith(magic):
-            raise ValueError(f"{what} {p} is {kind}, not a TOML case or study file; {BINARY_HINT}")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -557,6 +560,16 @@ def apply_overrides(data: Mapping[str, Any], overrides: list[str]) -> dict[str, 
                 raise ValueError(f"--set {item!r}: {k} is not a table")
         node[keys[-1]] = parsed
     return out
+
+
+def with_duration(data: dict[str, Any], seconds: float) -> dict[str, Any]:
+    """``data`` with [run] duration = ``seconds`` [s] where the case leaves it out (a [run] that is
+    no table is left to :func:`parse_case` to refuse): the command line's ``--duration`` stands for
+    it, and a preview (``rockdem show``) needs none."""
+    run = data.get("run", {})
+    if not isinstance(run, dict) or "duration" in run:
+        return data
+    return {**data, "run": {**run, "duration": float(seconds)}}
 
 
 def _run_options(top: Table) -> RunOptions:

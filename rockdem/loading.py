@@ -64,6 +64,7 @@ __all__ = [
     "apply_pushover",
     "RodPushover",
     "apply_rod_pushover",
+    "pushover_end",
     "rigid_rod_load_factor",
     "pushover",
     "rocking_axis_of",
@@ -397,6 +398,9 @@ class RodPushover:
         }
 
 
+ROD_RAMP_SHARE = 0.2
+"""The rod's half-cosine speed ramps at the start and the end of its push each last this share of
+the push time displacement / velocity (:func:`apply_rod_pushover`)."""
 QUASI_STATIC_WARN = 0.05
 """A rod pushover faster than this times sqrt(g H) (H the specimen's height) is warned about as not
 quasi-static (:func:`apply_rod_pushover`)."""
@@ -492,7 +496,7 @@ def apply_rod_pushover(
     # smooth start and stop (half-cosine speed ramps over 20 % of the push time each, no impact
     # on the face); the ramps lose and gain the same distance, so displacement = velocity * push_time
     push_time = float(displacement) / float(velocity)
-    tt = np.linspace(0.0, 0.2 * push_time, 41)
+    tt = np.linspace(0.0, ROD_RAMP_SHARE * push_time, 41)
     up_ = 0.5 * (1.0 - np.cos(np.pi * tt / tt[-1]))
     times = np.r_[tt, push_time + tt]
     speed = np.r_[up_, 1.0 - up_]
@@ -504,6 +508,26 @@ def apply_rod_pushover(
         warn_user("pushover rod in a model without gravity: its load factor is the rod force over the specimen's "
                   f"mass times the standard {STANDARD_GRAVITY} m/s^2 (it has no weight)")
     return RodPushover(name, float(velocity), float(displacement), h, d, mass * (gn or STANDARD_GRAVITY))
+
+
+class PushoverEnd(NamedTuple):
+    """When a pushover's load is complete: ``time`` [s] and ``what`` it then reaches (words)."""
+
+    time: float
+    what: str
+
+
+def pushover_end(attrs: Mapping[str, Any]) -> PushoverEnd | None:
+    """The end of the pushover described by a result's (or a case's) ``attrs``: for load control
+    the ramp's end, max_load_factor / rate; for a rod its full displacement, reached at 1.2
+    displacement / velocity (:func:`apply_rod_pushover`'s speed ramps over 0.2 of the push time at
+    each end); None for other loadings."""
+    if "pushover_rate" in attrs:
+        return PushoverEnd(float(attrs["pushover_max_load_factor"]) / float(attrs["pushover_rate"]), "its max_load_factor")
+    if "pushover_rod_velocity" in attrs:
+        push_time = float(attrs["pushover_displacement"]) / float(attrs["pushover_rod_velocity"])
+        return PushoverEnd((1.0 + ROD_RAMP_SHARE) * push_time, "its full displacement")
+    return None
 
 
 def rigid_rod_load_factor(b: float, h: float, z_rod: float, theta: ArrayLike) -> NDArray[np.float64]:

@@ -42,8 +42,8 @@ from .analysis import (
     result_eta,
     wme,
 )
-from .kernels.rotation import axis_angle_matrix, quats_to_matrices
 from .cli import dots_per_inch, positive_float
+from .kernels.rotation import axis_angle_matrix, quats_to_matrices
 from .style import STYLE, InlineFigure, save_figure
 
 __all__ = [
@@ -270,9 +270,7 @@ def plot_history(
     b = _block(ds, block)
     t = ds.time.values
     u, src = top_displacement(ds, monitor)
-    if length is not None and not float(length) > 0.0:
-        raise ValueError(f"length = {length!r}: the normalising length B must be positive [m] (None: the block's width)")
-    bw = float(length) if length is not None else block_dimensions(ds, b)[0]
+    bw = _normalising_length(ds, length, b)
     quake = ground_acceleration(ds)
     fig = InlineFigure(figsize=(_WIDTH, 4.6 if quake is None else 8.2))
     axes = fig.subplots(2 if quake is None else 5, 1, sharex=True)
@@ -534,14 +532,22 @@ def _labels(items: Sequence[xr.Dataset], labels: Sequence[str] | None) -> list[s
     return [str(x) for x in labels]
 
 
+def _normalising_length(ds: xr.Dataset, length: float | None, block: int | str | None) -> float:
+    """The length B [m] that u / B divides by: ``length``, or the block's width along the rocking
+    direction (None)."""
+    if length is None:
+        return float(block_dimensions(ds, block)[0])
+    if not float(length) > 0.0:
+        raise ValueError(f"length = {length!r}: the normalising length B must be positive [m] (None: the block's width)")
+    return float(length)
+
+
 def _quantity(ds: xr.Dataset, quantity: str, monitor: str | None, length: float | None) -> np.ndarray:
     if quantity == "rotation":
         return ds.rocking_angle.values[:, _block(ds, None)]
     if quantity == "displacement":
         u, _ = top_displacement(ds, monitor)
-        if length is not None and not float(length) > 0.0:
-            raise ValueError(f"length = {length!r}: the normalising length B must be positive [m] (None: the block's width)")
-        return u / (float(length) if length is not None else block_dimensions(ds, None)[0])
+        return u / _normalising_length(ds, length, None)
     raise ValueError(f"quantity must be 'displacement' (u/B) or 'rotation' [rad], got {quantity!r}")
 
 

@@ -67,15 +67,13 @@ def preview(model: Model, monitors: Mapping[str, tuple] | None = None, *, title:
 
 
 def _show(args: argparse.Namespace) -> int:
-    from .case import apply_overrides, example_case, load_case, parse_case
+    from .case import apply_overrides, example_case, load_case, parse_case, with_duration
     from .cli import output_file
 
     if (args.case is None) == (args.example is None):
         raise ValueError("give a case file (rockdem show CASE.toml) or --example NAME")
     data = apply_overrides(example_case(args.example) if args.example else load_case(args.case), args.set or [])
-    if isinstance(data.get("run", {}), dict) and "duration" not in data.get("run", {}):
-        data = apply_overrides(data, ["run.duration=1.0"])  # a preview runs nothing: a case without one is shown
-    case = parse_case(data)
+    case = parse_case(with_duration(data, 1.0))  # a preview runs nothing: a case without a duration is shown
     out = output_file(args.output if args.output else f"{case.name}_preview.png", "-o")
     p = save_figure(preview(case.model, case.monitors, title=case.name), out)
     print(repr(case.model))

@@ -20,11 +20,11 @@ import numpy as np
 import xarray as xr
 
 from .checkpoint import Checkpoint, load_checkpoint, structure_hash
-from .case import SETTLE_LONGEST, Case, apply_overrides, example_case, example_names, load_case, parse_case
+from .case import SETTLE_LONGEST, Case, apply_overrides, example_case, example_names, load_case, parse_case, with_duration
 from ._warn import warn_user
 from .cli import EXIT_DIVERGED, hold_signals, output_folder, positive_float, positive_int, stop_on_signals
 from .analysis import FALL_FRACTION, TIPPED_ANGLE, fallen_blocks
-from .loading import EQUILIBRIUM_TOLERANCE, load_carried
+from .loading import EQUILIBRIUM_TOLERANCE, load_carried, pushover_end
 from .results import export_csv, save, write_contact_table
 from .rocking_plot import PlotProcess, draw_rocking, rocking_series
 from .simulation import LIFT_1MM, REST_SHARE, _deferred_signals, simulate
@@ -102,16 +102,10 @@ def run_case(
         warn_user(f"the run ends at {options['duration']:g} s ([run] duration or --duration), before the record's peak "
                   f"ground acceleration (at {float(peak):.3g} s of the run): the specimen does not feel the strong "
                   "motion; lengthen the run")
-    a = case.attrs
-    if "pushover_rate" in a:  # load control: the ramp ends at max_load_factor / rate
-        end, what = float(a["pushover_max_load_factor"]) / float(a["pushover_rate"]), "its max_load_factor"
-    elif "pushover_rod_velocity" in a:  # the rod at full speed until displacement / velocity (its speed ramps down after)
-        end, what = float(a["pushover_displacement"]) / float(a["pushover_rod_velocity"]), "the end of its push"
-    else:
-        end = None
-    if end is not None and options["duration"] < end * (1.0 - 1e-9):
+    end = pushover_end(case.attrs)
+    if end is not None and options["duration"] < end.time * (1.0 - 1e-9):
         warn_user(f"the run ends at {options['duration']:g} s ([run] duration or --duration), before the pushover reaches "
-                  f"{what} (at {end:.4g} s): the capacity curve stops short of it; lengthen the run")
+                  f"{end.what} (at {end.time:.4g} s): the capacity curve stops short of it; lengthen the run")
     ds = simulate(case.model, **options, progress=progress, initial=initial, checkpoint=checkpoint,
                   checkpoint_every=checkpoint_every, threads=threads)
     with _deferred_signals(finishing=True):  # the frames are computed: a stop signal waits for the result
@@ -357,10 +351,8 @@ def _run(args: argparse.Namespace) -> int:
     data = apply_overrides(data, args.set or [])
     if args.stop is not None:
         data = apply_overrides(data, [f'run.stop="{args.stop}"'])
-    if args.duration is not None and "duration" not in (data.get("run") or {}):
-        # --duration stands for a [run] duration the case leaves out (before 2026-12-01 such a case
-        # was refused, "[run] duration is required", whatever --duration said)
-        data = apply_overrides(data, [f"run.duration={args.duration!r}"])
+    if args.duration is not None:  # (before 2026-12-01 a case without one was refused whatever --duration said)
+        data = with_duration(data, args.duration)
     t0 = time.perf_counter()
     case = parse_case(data)
     initial = None
@@ -371,7 +363,7 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out or case.output["directory"] or Path("results") / case.name)
     files = ("result.nc", "histories.csv", "rocking.png", "checkpoint.npz", "contacts.csv", "contacts.parquet")
     output_folder(out, "--out" if args.out else "[output] directory" if case.output["directory"] else "output folder", files)
-    earlier = [f for f in files if (out / f).exists()]  # an earlier run's outputs (named below if not rewritten)
+    earlier = _stamps(out, files)  # an earlier run's outputs (named below where this run does not rewrite them)
     save_ck = case.output["checkpoint"] and not args.no_checkpoint
     every = args.checkpoint_every if args.checkpoint_every is not None else case.output["checkpoint_every"]
     if every is not None and not save_ck:
@@ -403,8 +395,10 @@ def _run(args: argparse.Namespace) -> int:
                 if "checkpoint" in ds.attrs:
                     written.append(Path(ds.attrs["checkpoint"]))
         except KeyboardInterrupt:  # a second stop signal abandoned the save: say what the folder holds
-            left = _left_over(out, earlier, written)
-            print(f"rockdem run: the save was abandoned; written: {', '.join(p.name for p in written) or 'nothing'}"
+            now = _stamps(out, files)
+            new = [f for f in now if earlier.get(f) != now[f]]
+            left = [f for f in now if earlier.get(f) == now[f]]
+            print(f"rockdem run: the save was abandoned; written: {', '.join(new) or 'nothing'}"
                   + (f"; {out} also holds {', '.join(left)} of an earlier run" if left else ""), file=sys.stderr)
             raise
     print(f"rockdem run: {case.name}")
@@ -413,7 +407,8 @@ def _run(args: argparse.Namespace) -> int:
     print("  " + _row("wall time", f"{wall:.2f}", "s", "including set-up (and compilation on a first run)"))
     for p in written:
         print("  " + _row("wrote", "", "", str(p)))
-    left = _left_over(out, earlier, written)
+    now = _stamps(out, files)
+    left = [f for f in now if earlier.get(f) == now[f]]
     if left:  # (before 2026-12-01 they stayed beside the new result without a word)
         print(f"rockdem run: warning: {out} also holds {', '.join(left)} of an earlier run, not written by this one "
               "(remove them, or give another --out)", file=sys.stderr)
@@ -427,11 +422,17 @@ def _run(args: argparse.Namespace) -> int:
     return EXIT_DIVERGED if ds.attrs.get("diverged") else 0
 
 
-def _left_over(out: Path, earlier: list[str], written: list[Path]) -> list[str]:
-    """The output files ``earlier`` (names) that were in ``out`` before this run and that it did
-    not write (still there)."""
-    names = {Path(p).name for p in written}
-    return [f for f in earlier if f not in names and (out / f).exists()]
+def _stamps(out: Path, files: tuple[str, ...]) -> dict[str, tuple[int, int]]:
+    """(modification time [ns], size [bytes]) of each of ``files`` found in ``out``, by name: a file
+    whose stamp a run left unchanged is an earlier run's."""
+    stamps = {}
+    for f in files:
+        try:
+            st = (out / f).stat()
+        except OSError:
+            continue
+        stamps[f] = (st.st_mtime_ns, st.st_size)
+    return stamps
 
 
 def register_cli(subparsers: argparse._SubParsersAction) -> None:

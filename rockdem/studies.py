@@ -879,21 +879,24 @@ def run_study(study: Study, out: str | os.PathLike[str], *, executor: str | None
 
 def read_with_care(df: pd.DataFrame) -> list[str]:
     """Notes on the rows of a study table whose figures to read with care (the runs' own warnings
-    are silenced inside a study): runs whose contacts created energy beyond
-    :data:`rockdem.simulation.ENERGY_DRIFT_SHARE` of their energy scale (the warning a single run
-    gives), and free-rocking runs whose mean apparent restitution ``e_a_mean`` exceeds 1 (the
-    rocking grew between impacts, which no restitution model gives: Eq. 6 then reads no loss).
-    One note per kind, naming the worst run; an empty list when none."""
+    are silenced inside a study): runs whose ``energy_created_J`` (the largest rise of their
+    mechanical energy beyond the work done) exceeds :data:`rockdem.simulation.ENERGY_DRIFT_SHARE`
+    of their energy scale (the share at which a single run warns of its balance error), and
+    free-rocking runs whose mean apparent restitution ``e_a_mean`` exceeds 1 (the rocking grew
+    between impacts, which no restitution model gives: Eq. 6 then reads no loss). One note per
+    kind, naming the worst run; an empty list when none. (A row carries no free mass, so runs
+    whose energies are noise, without gravity or load, are not told apart as a single run does.)"""
     from .simulation import ENERGY_DRIFT_SHARE
 
     notes = []
     if {"energy_created_J", "energy_scale_J"} <= set(df.columns):
-        share = df["energy_created_J"] / df["energy_scale_J"].where(df["energy_scale_J"] > 0.0)
+        created, scale = (pd.to_numeric(df[c], errors="coerce") for c in ("energy_created_J", "energy_scale_J"))
+        share = created / scale.where(scale > 0.0)
         bad = share[share > ENERGY_DRIFT_SHARE]
         if len(bad):
             k = bad.idxmax()
             notes.append(f"{len(bad)} of {len(df)} runs created energy beyond {ENERGY_DRIFT_SHARE:.0%} of their energy scale "
-                         f"(the most: run {df.at[k, 'id']}, {df.at[k, 'energy_created_J']:.3g} J, {bad[k]:.1%}; column "
+                         f"(the most: run {df.at[k, 'id']}, {created[k]:.3g} J, {bad[k]:.1%}; column "
                          "energy_created_J): fast impacts on small faces, blocks passing through one another; read those "
                          "rows with care (docs/contacts.md section 5)")
     if "e_a_mean" in df.columns:

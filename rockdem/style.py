@@ -11,6 +11,8 @@ from pathlib import Path
 from matplotlib import rc_context
 from matplotlib.figure import Figure
 
+from .cli import MAX_DPI
+
 __all__ = ["STYLE", "InlineFigure", "save_figure"]
 
 STYLE: dict[str, object] = {
@@ -45,8 +47,6 @@ class InlineFigure(Figure):
 
 def save_figure(fig: Figure, path: str | Path, *, dpi: float | None = None) -> Path:
     """Write a figure as PNG or PDF (by suffix) with the fixed style; returns the path."""
-    from .cli import MAX_DPI
-
     p = Path(path)
     if p.suffix.lower() not in (".png", ".pdf"):
         raise ValueError(f"output {p}: the suffix must be .png or .pdf")

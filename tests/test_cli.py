@@ -177,7 +177,7 @@ def test_an_interrupt_while_saving_is_held_and_a_second_abandons_the_save(tmp_pa
         assert (out / "result.nc").exists() == saved
         if not saved:
             assert "stopped by SIGINT" in err
-            assert "the save was abandoned; written: nothing" in err
+            assert "the save was abandoned; written: checkpoint.npz" in err  # (written by the run itself)
         else:
             assert "SIGINT came after the run had ended; the result is complete" in err
 
@@ -580,6 +580,9 @@ def test_duration_on_the_command_line_stands_for_a_missing_one(tmp_path, capsys)
     assert "[run] duration is required" in capsys.readouterr().err
     assert main(["show", str(case), "-o", str(tmp_path / "p.png")]) == 0
     assert (tmp_path / "p.png").exists()
+    case.write_text("run = 5\n" + case.read_text())  # a [run] that is no table is refused as without --duration
+    assert main(["run", str(case), "--out", str(tmp_path / "o3"), "--duration", "0.1", "--quiet"]) == 2
+    assert "[run] must be a table" in capsys.readouterr().err
 
 
 def test_a_result_checkpoint_or_image_given_as_a_case_is_named(tmp_path, capsys):

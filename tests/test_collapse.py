@@ -12,6 +12,7 @@ import sys
 import tempfile
 import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -929,8 +930,13 @@ def test_a_face_pair_held_at_its_sets_hands_nothing_over_when_its_faces_change()
     model = _random_hull_pile(33, 4.0)
     h1, h3 = model.block_id("h1"), model.block_id("h3")
 
-    def face_pair(t: float, tmp: str):
-        """The FACE pair of h1 and h3 at time t: (owner face, target face, sets [m], normal forces [N])."""
+    class FacePair(NamedTuple):
+        faces: tuple[int, int]  # owner, target
+        sets: np.ndarray  # [m] of its tracked sub-contacts
+        normal_forces: np.ndarray  # [N]
+
+    def face_pair(t: float, tmp: str) -> FacePair:
+        """The FACE pair of h1 and h3 at time t."""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             out = run_model(model, t, record_interval=0.0002, progress=False, checkpoint=tmp)
@@ -938,16 +944,16 @@ def test_a_face_pair_held_at_its_sets_hands_nothing_over_when_its_faces_change()
         for i in range(st.pair_count[0]):
             if (st.pair_a[i], st.pair_b[i]) == (h1, h3) and st.pair_kind[i] == PAIR_FACE:
                 slots = [divmod(int(st.track[k]), SLOTS) for k in range(st.pair_track_start[i], st.pair_track_stop[i])]
-                return (int(st.pair_owner_face[i]), int(st.pair_target_face[i]), np.array([st.slot_set[p, j] for p, j in slots]),
-                        np.array([st.slot_normal_force[p, j] for p, j in slots]))
+                return FacePair((int(st.pair_owner_face[i]), int(st.pair_target_face[i])),
+                                np.array([st.slot_set[p, j] for p, j in slots]), np.array([st.slot_normal_force[p, j] for p, j in slots]))
         raise AssertionError(f"no FACE pair of h1 and h3 at {t} s")
 
     with tempfile.TemporaryDirectory() as tmp:
         before = face_pair(0.1252, f"{tmp}/a.npz")
         after = face_pair(0.1254, f"{tmp}/b.npz")
-    assert before[2].max() > 2e-3 and not before[3].any()  # held 2.4 mm deep at its set, unloaded
-    assert before[:2] != after[:2]  # its faces change
-    assert after[2].max() > 2e-3  # the new springs start at their depths (sets), not loaded from them
+    assert before.sets.max() > 2e-3 and not before.normal_forces.any()  # held 2.4 mm deep at its set, unloaded
+    assert before.faces != after.faces  # its faces change
+    assert after.sets.max() > 2e-3  # the new springs start at their depths (sets), not loaded from them
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ds = simulate(model, 0.13, record_interval=0.0002, progress=False)

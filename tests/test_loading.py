@@ -399,7 +399,7 @@ def test_a_pushover_cut_short_by_its_duration_is_warned_about():
     the rod's push ends (displacement control), says so, as an earthquake run ended before the
     record's peak does (before 2026-12-01 only the summary's applied factor showed it)."""
     for name, end in (("pushover_0.2x2.0_points2", "its max_load_factor (at 4.75 s)"),
-                      ("pushover_rod_0.2x2.0_points10", "the end of its push (at 10 s)")):
+                      ("pushover_rod_0.2x2.0_points10", "its full displacement (at 12 s)")):
         case = parse_case(load_case(EXAMPLES / f"{name}.toml"))
         with pytest.warns(UserWarning, match=re.escape(f"the run ends at 0.02 s ([run] duration or --duration), before the "
                                                        f"pushover reaches {end}")):

@@ -14,6 +14,7 @@ The B = 0.2 m, H = 2 m, L = 1 m block (1800 kg/m^3, E = 1800 MPa, kn = E / H, no
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import matplotlib
@@ -60,7 +61,11 @@ def pushover_case(points: int, duration: float) -> dict[str, Any]:
 
 
 def _pushover(points: int, duration: float) -> dict[str, np.ndarray]:
-    ds = run_case(parse_case(pushover_case(points, duration)), progress=False)
+    with warnings.catch_warnings():
+        # The run stops at 0.9 of the rod's displacement (its speed ramps down past ``duration``)
+        # on purpose: the table reads the curve up to u_top = 40 mm (theta 0.02 of eta's 0.1 rad).
+        warnings.filterwarnings("ignore", message="the run ends at .* before the pushover reaches")
+        ds = run_case(parse_case(pushover_case(points, duration)), progress=False)
     lam, u = capacity_curve(ds)
     return {"lam": lam, "u": u, "theta": ds.rocking_angle.values[:, 1], "runtime_s": float(ds.attrs["runtime_s"])}
 
