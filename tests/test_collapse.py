@@ -916,19 +916,20 @@ def test_a_face_pair_changing_faces_under_load_hands_its_energy_over():
 
 
 def test_a_face_pair_held_at_its_sets_hands_nothing_over_when_its_faces_change():
-    """In a random pile (seed 33, dropped at 4 m/s) a hull's contact is held 2.4 mm deep at its
-    set, unloaded (handed over before), when its faces change at 0.1252 s. The new face's points
-    found at that depth started loaded (6.2 J at once, with the incident face of 2026-12-01) while
-    the old springs held nothing to hand over: a pair held at its sets now hands over nothing, and
-    its new springs start unloaded at their depths (detect._pair_touching). The event is checked
-    to happen (the pile is chaotic: a change elsewhere may move it, and then this test must be
-    given another)."""
+    """In a random pile (seed 72, dropped at 4 m/s) a hull's contact with another is held 6 to 11 mm
+    deep at its sets, unloaded (handed over before), when its faces change at 0.0892 s (target face
+    56 -> 45). New points found at that depth would start loaded, while the old springs hold nothing
+    to hand over (seed 33 of the same generator showed it at 0.1252 s with the deepest covered
+    vertex: 6.2 J created at once): a pair held at its sets hands over nothing, and its new springs
+    start unloaded at their depths (detect._pair_touching). The event is checked to happen (the
+    pile is chaotic: a change elsewhere may move it, and then this test must be given another; the
+    deepest covered point's blend of 2026-12-01 moved seed 33's)."""
     from rockdem.checkpoint import load_checkpoint
     from rockdem.kernels.layout import PAIR_FACE, SLOTS
     from rockdem.simulation import run_model
 
-    model = _random_hull_pile(33, 4.0)
-    h1, h3 = model.block_id("h1"), model.block_id("h3")
+    model = _random_hull_pile(72, 4.0)
+    h1, h2 = model.block_id("h1"), model.block_id("h2")
 
     class FacePair(NamedTuple):
         faces: tuple[int, int]  # owner, target
@@ -936,28 +937,28 @@ def test_a_face_pair_held_at_its_sets_hands_nothing_over_when_its_faces_change()
         normal_forces: np.ndarray  # [N]
 
     def face_pair(t: float, tmp: str) -> FacePair:
-        """The FACE pair of h1 and h3 at time t."""
+        """The FACE pair of h1 and h2 at time t."""
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             out = run_model(model, t, record_interval=0.0002, progress=False, checkpoint=tmp)
         st = load_checkpoint(out.attrs["checkpoint"]).state
         for i in range(st.pair_count[0]):
-            if (st.pair_a[i], st.pair_b[i]) == (h1, h3) and st.pair_kind[i] == PAIR_FACE:
+            if (st.pair_a[i], st.pair_b[i]) == (h1, h2) and st.pair_kind[i] == PAIR_FACE:
                 slots = [divmod(int(st.track[k]), SLOTS) for k in range(st.pair_track_start[i], st.pair_track_stop[i])]
                 return FacePair((int(st.pair_owner_face[i]), int(st.pair_target_face[i])),
                                 np.array([st.slot_set[p, j] for p, j in slots]), np.array([st.slot_normal_force[p, j] for p, j in slots]))
-        raise AssertionError(f"no FACE pair of h1 and h3 at {t} s")
+        raise AssertionError(f"no FACE pair of h1 and h2 at {t} s")
 
     with tempfile.TemporaryDirectory() as tmp:
-        before = face_pair(0.1252, f"{tmp}/a.npz")
-        after = face_pair(0.1254, f"{tmp}/b.npz")
-    assert before.sets.max() > 2e-3 and not before.normal_forces.any()  # held 2.4 mm deep at its set, unloaded
+        before = face_pair(0.0890, f"{tmp}/a.npz")
+        after = face_pair(0.0892, f"{tmp}/b.npz")
+    assert before.sets.max() > 5e-3 and not before.normal_forces.any()  # held 6 to 11 mm deep at its sets, unloaded
     assert before.faces != after.faces  # its faces change
-    assert after.sets.max() > 2e-3  # the new springs start at their depths (sets), not loaded from them
+    assert after.sets.max() > 5e-3  # the new springs start at their depths (sets), not loaded from them
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ds = simulate(model, 0.13, record_interval=0.0002, progress=False)
+        ds = simulate(model, 0.095, record_interval=0.0002, progress=False)
     net = (ds.energy_kinetic + ds.energy_potential + ds.energy_elastic).values
     scale = float(net[0] - net.min())
-    assert float(np.max(net - np.minimum.accumulate(net))) <= 1e-3 * scale  # 0.000 J (6.2 J before)
+    assert float(np.max(net - np.minimum.accumulate(net))) <= 1e-3 * scale  # 0.000 J (seed 33: 6.2 J before the rule)
     assert float(np.max(np.abs(ds.energy_balance_error_relative.values))) < 0.01

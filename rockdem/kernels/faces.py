@@ -6,7 +6,7 @@ projection along the target normal; the height of an owner-plane point above the
 affine too. A point's *effective area* is the part of its tributary cell that the target polygon
 covers (the cell clipped by the target's edge lines); its force acts at the point itself when the
 cell is covered (the paper's interface-point quadrature, §3.3); a partly covered cell's force
-moves from the point (or the nearest covered point) towards the deepest covered vertex, as far as
+moves from the point (or the nearest covered point) towards the deepest covered point, as far as
 that is deeper and the cell uncovered (nothing on a flat joint; all the way where an edge of the
 other block crosses a tilted cell). The
 area varies continuously as the blocks slide, so a sub-contact's force fades out smoothly as it
@@ -24,13 +24,17 @@ import numpy as np
 from numba import njit
 
 from .layout import ModelArrays, Scratch, State
-from .polygon import clip_edge, clip_halfplane, deepest_vertex, nearest_on_polygon, polygon_area
+from .polygon import clip_edge, clip_halfplane, deepest_point, nearest_on_polygon, polygon_area
 
 INSIDE_TOL = 1e-10
 """[m] a cell vertex this close outside a target edge counts as inside (round-off of flush joints)."""
 
 DEPTH_TIE = 1e-7
 """[m] covered-cell vertices this close to the deepest count as equally deep."""
+
+DEPTH_BLEND = 0.1
+"""Covered-cell vertices within this share of the cell's depth range of the deepest share its
+deepest point (:func:`rockdem.kernels.polygon.deepest_point`)."""
 
 OFF_BLEND = 10.0
 """A point off its target polygon by this many touching tolerances has its force at the deepest
@@ -275,7 +279,7 @@ def anchored_overlap(
     fm: FaceMap, nu: float, nw: float, au: float, aw: float, eu: float, ew: float, cover_w: float, touch_tol: float,
 ) -> float:
     """Overlap [m] of point (nu, nw)'s cell at the pose of ``fm``, measured as :func:`partly_covered`
-    measures it, with its cover weight w, anchor q = (au, aw) and deepest covered vertex d = (eu, ew)
+    measures it, with its cover weight w, anchor q = (au, aw) and deepest covered point d = (eu, ew)
     (owner face coordinates [m]) kept: u_q + w phi(g), or the point's own overlap where w is 0
     (q and d are then not read). With those of the last step: how deep the cell would be now had
     its cover not moved."""
@@ -299,7 +303,8 @@ def partly_covered(
     target's edge lines in ``mask``, :func:`crossing_lines`); points in owner face coordinates [m].
 
     The force point: from the point p (or the nearest covered point q when p is off the target)
-    towards the deepest covered vertex d, by w phi'(g): w the cover weight (how much of the cell is
+    towards the deepest covered point d (:func:`rockdem.kernels.polygon.deepest_point`: the mean of
+    the covered vertices near the deepest, continuous as they cross), by w phi'(g): w the cover weight (how much of the cell is
     uncovered relative to COVER_BLEND, or how far p is off the target), g = u_d - u_p how much
     deeper d is, phi the ramp smoothed over tau = touch_tol (phi(g) = g^2 / (2 tau) below tau,
     g - tau / 2 above, phi' = min(g / tau, 1)). The overlap of the sub-contact is
@@ -363,8 +368,8 @@ def _cover_tail(
     au, aw, eu, ew = nu, nw, nu, nw
     if area > 0.0:
         # The force point of a partly covered cell: from the point itself (or the nearest covered
-        # point when the point is off the target) towards the deepest covered vertex, as far as that
-        # vertex is deeper (relative to the touching tolerance) and the cell is uncovered (relative
+        # point when the point is off the target) towards the deepest covered point, as far as that
+        # point is deeper (relative to the touching tolerance) and the cell is uncovered (relative
         # to COVER_BLEND). On a flat joint nothing moves; where an edge of the other block crosses
         # the cell (a tilted block on the edge of a narrower one) the cell is held on that edge.
         if node_in:
@@ -374,7 +379,7 @@ def _cover_tail(
         inv = 1.0 / fm.det
         gu = inv * (fm.hu * fm.m11 - fm.hw * fm.m10)  # height above the target plane in target coordinates
         gw = inv * (-fm.hu * fm.m01 + fm.hw * fm.m00)
-        du_, dw_ = deepest_vertex(buf, cur, n, gu, gw, nu_, nw_, DEPTH_TIE)
+        du_, dw_ = deepest_point(buf, cur, n, gu, gw, DEPTH_BLEND, DEPTH_TIE)
         gain = gu * (nu_ - du_) + gw * (nw_ - dw_)
         uncovered = 1.0 - area / point_area
         # A point off the target is no interface point of this contact any more: the farther off
@@ -489,7 +494,7 @@ def cut_cell(
     mask: int, lumped: bool, target_cell_area: float,
 ) -> tuple[float, float, float, float, float, float, float, float, float]:
     """Effective area, force point (u, w), depth shift, cover weight, anchor (u, w) and
-    deepest covered vertex (u, w) (those of :func:`partly_covered`; no shift and weight, and the
+    deepest covered point (u, w) (those of :func:`partly_covered`; no shift and weight, and the
     node as anchor and vertex, for a cell wholly covered or not at all) of point p's cell (node (nu, nw), area
     ``point_area``) against target face ``ft`` grown by ``grow`` [m], tested against the target
     edge lines of ``mask`` (:func:`crossing_lines`, or ALL_LINES): :func:`covered`, then

@@ -184,7 +184,7 @@ class State(NamedTuple):
     # (kernels.faces.partly_covered; 0 wholly covered): its change at a pose is a cover change (forces.cover_change)
     slot_anchor: np.ndarray  # (np, SLOTS, 2) [m] (u, w) owner face coordinates of the point a partly covered
     # cell's overlap is measured at (its own, or the nearest covered one), at the last force pass where slot_cover > 0
-    slot_deepest: np.ndarray  # (np, SLOTS, 2) [m] (u, w) its deepest covered vertex, likewise
+    slot_deepest: np.ndarray  # (np, SLOTS, 2) [m] (u, w) its deepest covered point, likewise
     slot_bonded: np.ndarray  # (np, SLOTS) bool
     slot_stiffening: np.ndarray  # (np, SLOTS) [-] area factor of a corner that landed alone (vertex-face contact), 1 otherwise
     point_failed: np.ndarray  # (np,) int64 FAILED_*

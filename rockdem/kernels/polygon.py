@@ -84,23 +84,27 @@ def nearest_on_polygon(buf: np.ndarray, b: int, n: int, x: float, y: float) -> t
 
 
 @njit(cache=True, _nrt=False, inline="always")
-def deepest_vertex(
-    buf: np.ndarray, b: int, n: int, hu: float, hw: float, x: float, y: float, tie: float
-) -> tuple[float, float]:
-    """Vertex of polygon ``buf[b, :n]`` where the height hu u + hw w (+ a constant) is lowest (the
-    deepest overlap); vertices within ``tie`` [m] of the lowest count as equal and the one nearest
-    to (x, y) is taken."""
+def deepest_point(buf: np.ndarray, b: int, n: int, hu: float, hw: float, share: float, tie: float) -> tuple[float, float]:
+    """The deepest part of polygon ``buf[b, :n]`` under the height hu u + hw w (+ a constant): the
+    mean of its vertices weighted by 1 - (h - h_low) / band, h_low the lowest height and band =
+    max(``share`` times the vertices' height range, ``tie`` [m]); vertices higher than h_low + band
+    weigh nothing. A continuous function of the heights, unlike the lowest vertex itself, which
+    jumps between two nearly equally deep vertices as they cross."""
     low = np.inf
+    high = -np.inf
     for i in range(n):
-        low = min(low, hu * buf[b, i, 0] + hw * buf[b, i, 1])
-    best = np.inf
-    bx, by = x, y
+        h = hu * buf[b, i, 0] + hw * buf[b, i, 1]
+        low = min(low, h)
+        high = max(high, h)
+    band = max(share * (high - low), tie)
+    su = sw = sum_w = 0.0
     for i in range(n):
-        if hu * buf[b, i, 0] + hw * buf[b, i, 1] <= low + tie:
-            d = (buf[b, i, 0] - x) ** 2 + (buf[b, i, 1] - y) ** 2
-            if d < best:
-                best, bx, by = d, buf[b, i, 0], buf[b, i, 1]
-    return bx, by
+        wi = 1.0 - (hu * buf[b, i, 0] + hw * buf[b, i, 1] - low) / band
+        if wi > 0.0:
+            su += wi * buf[b, i, 0]
+            sw += wi * buf[b, i, 1]
+            sum_w += wi
+    return su / sum_w, sw / sum_w
 
 
 @njit(cache=True, _nrt=False, inline="always")
