@@ -30,7 +30,8 @@ INSIDE_TOL = 1e-10
 """[m] a cell vertex this close outside a target edge counts as inside (round-off of flush joints)."""
 
 DEPTH_TIE = 1e-7
-"""[m] covered-cell vertices this close to the deepest count as equally deep."""
+"""[m] the least depth band of a covered cell's deepest point (a cell whose vertices are all this
+close in depth: a flat joint)."""
 
 DEPTH_BLEND = 0.1
 """Covered-cell vertices within this share of the cell's depth range of the deepest share its
@@ -38,7 +39,7 @@ deepest point (:func:`rockdem.kernels.polygon.deepest_point`)."""
 
 OFF_BLEND = 10.0
 """A point off its target polygon by this many touching tolerances has its force at the deepest
-covered vertex of its cell (the blend towards it starts as the point leaves the polygon)."""
+covered point of its cell (the blend towards it starts as the point leaves the polygon)."""
 
 COVER_BLEND = 0.05
 """A cell covered to more than 1 - COVER_BLEND of its area keeps its force at its point (it moves
@@ -304,9 +305,9 @@ def partly_covered(
 
     The force point: from the point p (or the nearest covered point q when p is off the target)
     towards the deepest covered point d (:func:`rockdem.kernels.polygon.deepest_point`: the mean of
-    the covered vertices near the deepest, continuous as they cross), by w phi'(g): w the cover weight (how much of the cell is
-    uncovered relative to COVER_BLEND, or how far p is off the target), g = u_d - u_p how much
-    deeper d is, phi the ramp smoothed over tau = touch_tol (phi(g) = g^2 / (2 tau) below tau,
+    the covered vertices near the deepest, continuous as they cross), by w phi'(g): w the cover
+    weight (how much of the cell is uncovered relative to COVER_BLEND, or how far p is off the
+    target), g = u_d - u_p how much deeper d is, phi the ramp smoothed over tau = touch_tol (phi(g) = g^2 / (2 tau) below tau,
     g - tau / 2 above, phi' = min(g / tau, 1)). The overlap of the sub-contact is
     u = u_p + w phi(g), whose gradient in the blocks' motion is exactly a unit normal force at that
     point (for fixed w, q and d): the spring is then the gradient of its energy kn A u^2 / 2 and
