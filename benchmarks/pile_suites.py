@@ -143,12 +143,17 @@ def _line(name: str, r: dict) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("suites", nargs="*", choices=[[], *SUITES], help="suites to run (default all)")
+    p.add_argument("suites", nargs="*", help=f"suites to run: {', '.join(SUITES)} (default all)")
     p.add_argument("--seeds", help="a:b, the seeds range(a, b) (default each suite's)")
     p.add_argument("--jobs", type=int, default=1, help="processes (default 1)")
     a = p.parse_args(argv)
+    unknown = [n for n in a.suites if n not in SUITES]
+    if unknown:
+        p.error(f"unknown suite(s) {', '.join(unknown)}: choose from {', '.join(SUITES)}")
     for name in a.suites or list(SUITES):
         seeds = range(*map(int, a.seeds.split(":"))) if a.seeds else range(SUITES[name].seeds)
+        if not seeds:
+            p.error(f"--seeds {a.seeds}: no seeds in that range; give a:b with a < b")
         with ProcessPoolExecutor(a.jobs) as pool:
             rows = []
             for r in pool.map(run_one, [name] * len(seeds), seeds):
