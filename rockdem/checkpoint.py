@@ -48,12 +48,13 @@ from .timestep import TimestepInfo
 __all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
-FORMAT_VERSION = 10
+FORMAT_VERSION = 11
 """Version of the checkpoint file layout; a file of another version is refused. (2: the model
 hash covers ``ModelArrays.face_corner_uw``, so a version-1 file's hash would not match. 3: the
 state holds ``slot_stiffening`` and ``slot_updates``, the model ``point_corner``. 5: the state
 holds ``slot_cover``, the scratch ``pair_handover``. 6: the state holds ``velocity_lag``. 10: the
-state holds ``slot_anchor`` and ``slot_deepest``, the scratch ``driven_force_last`` and ``driven_dashpot``.)"""
+state holds ``slot_anchor`` and ``slot_deepest``, the scratch ``driven_force_last`` and ``driven_dashpot``. 11: the
+scratch holds ``prev_pair_weight``.)"""
 
 LOADING_FIELDS = frozenset(
     {"block_motion", "motion_start", "motion_time", "motion_velocity", "ground_motion", "body_time",

@@ -73,6 +73,7 @@ def _scratch_pairs(count: int) -> dict[str, np.ndarray]:
         "prev_pair_normal_force": np.zeros(count),
         "prev_pair_overlap": np.zeros(count),
         "prev_pair_set": np.zeros(count),
+        "prev_pair_weight": np.zeros(count),
         "prev_pair_key": np.zeros(count, dtype=i64),
         "prev_pair_index": np.zeros(count, dtype=i64),
         "prev_pair_kept": np.zeros(count, dtype=np.bool_),

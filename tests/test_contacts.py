@@ -308,3 +308,39 @@ def test_a_quad_cell_cut_by_one_line_is_clipped_as_the_generic_polygon_is(rng):
         if state == COVER_PART and not lumped:
             assert fast[0] == pytest.approx(_clip_area(mapped, *lines[li]) / abs(fm.det), rel=1e-9), f"trial {trial}"
     assert partial > 300
+
+
+def test_a_flat_cells_deepest_point_moves_continuously_as_its_ends_cross():
+    """A partly covered cell pressed flat into its target (a crack closed along a wall's length)
+    twists about its short axis: its ends' depths cross. Its deepest covered point (the force
+    point's goal, faces.partly_covered) must slide along the cell as they do, not jump from end to
+    end: a jump at a fixed pose is a cover change that goes into the cell's set while the force
+    point moves, and the step's work then falls short of what the spring holds at each turn of
+    the twist. With the vertices within 1e-7 m of the deepest sharing the point (before
+    2026-12-07) it jumped the cell's 0.5 m length within a 5e-7 m change of the ends' depths; a
+    two-block wall's crack (Poisson 0.45, undamped) lost 1.3 % of its energy scale at such turns.
+    Now the band is the touching tolerance: the point moves in proportion to the depths."""
+    from rockdem.kernels.faces import FaceMap, partly_covered
+
+    touch = 2e-4
+    length, width = 0.5, 0.05
+    quad = np.array([[0.0, 0.0], [length, 0.0], [length, width], [0.0, width]])
+    cell_start = np.array([0, 4])
+    lines = np.array([[0.0, 1.0, 0.03]])  # the target covers w <= 0.03 (60 % of the cell)
+    line_start = np.array([0, 1])
+    area = length * width
+    buf = np.zeros((2, 32, 2))
+    points = []
+    slopes = np.linspace(-1.2, 1.2, 2401) * touch / length  # the ends' depths differ by up to 1.2 tau
+    for slope in slopes:
+        fm = FaceMap(0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0,
+                     1.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1e-3, slope, 0.0, 1.0)
+        out = partly_covered(cell_start, quad, line_start, lines, buf, 0.25, 0.025, area, touch, 0, 0, fm, 0.0, False, 1.0, 1)
+        assert out[0] == pytest.approx(0.6 * area)
+        points.append(out[7])  # the deepest covered point's u
+    points = np.array(points)
+    assert points[0] == pytest.approx(length) and points[-1] == pytest.approx(0.0)  # the deeper end
+    assert points[len(points) // 2] == pytest.approx(0.5 * length)  # level: the middle
+    step_depth = (slopes[1] - slopes[0]) * length
+    # At most 4 times the cell's length per touching tolerance of the ends' depths.
+    assert np.abs(np.diff(points)).max() <= 4.0 * length * step_depth / touch

@@ -15,13 +15,16 @@ points 1 - lambda: on a flat joint, a block on a foundation or a block rocking o
 (c <= 0) nothing changes.
 
 A weight that depends on the configuration is only energy-consistent if its own gradient is
-applied: with U_o, U_t the normal spring energies of the two quadratures, the contact energy is
-U = (1 - lambda) U_o + lambda U_t, whose gradient adds -(U_t - U_o) lambda'(c) grad c to the two
-sets of spring forces. grad sep_o is a unit force pair along the owner face's normal at the target's
-deepest vertex (and likewise for sep_t), so the correction is two small force pairs
+applied: with U_o, U_t the normal spring energies of the two quadratures at full share, the contact
+energy is U = (1 - lambda) U_o + lambda U_t, whose gradient adds -(U_t - U_o) lambda'(c) grad c to
+the two sets of spring forces. grad sep_o is a unit force pair along the owner face's normal at the
+target's deepest vertex (and likewise for sep_t), so the correction is two small force pairs
 (:func:`blend_forces`). Switching the owner outright at a detection instead changed the stored
 energy of a loaded contact in one step (a discretised parapet under El Centro x 5 created 2.8 % of
-its energy).
+its energy). The shear springs, whose extension is a history and not a function of the pose, follow
+a side's share as they follow a cell's cover (forces.cover_change): a growing share scales the
+extension so that the spring keeps its energy, a shrinking one dissipates what it holds less
+(forces._law_range).
 """
 
 from __future__ import annotations

@@ -707,10 +707,18 @@ def _narrow(m: ModelArrays, s: State, sc: Scratch, a: int, b: int, ncand: int) -
         # springs start unloaded at their overlaps.
         sc.pair_handover[i] = _prev_edge_energy_now(m, s, sc, prev, m.mat_kn[m.block_group[a], m.block_group[b]])
         sc.prev_pair_normal_force[prev] = 0.0
+    sc.pair_weight[i] = -1.0  # (a new pair's share at its last law pass is not known)
     if prev >= 0 and sc.prev_pair_kind[prev] == PAIR_FACE:  # (an EDGE pair turned FACE hands over, above)
         sc.prev_pair_kept[prev] = True
         po, pt = sc.prev_pair_owner_face[prev], sc.prev_pair_target_face[prev]
         changed = not ((fo == po and ft == pt) or (fo == pt and ft == po))
+        # The same faces carry on: the target's share at the last law pass, for the cover's change
+        # of a cell whose area holds that share (forces._law_range); the owner and target may swap.
+        w = sc.prev_pair_weight[prev]
+        if fo == po and ft == pt:
+            sc.pair_weight[i] = w
+        elif not changed and w >= 0.0:
+            sc.pair_weight[i] = 1.0 - w
         fresh = not _has_slots(m, s, fo, m.face_block[ft]) and not (both and _has_slots(m, s, ft, m.face_block[fo]))
         if changed or fresh:
             # Other faces carry the contact now, or none of its springs goes on: the new faces'
@@ -952,6 +960,7 @@ def detect(m: ModelArrays, s: State, sc: Scratch) -> None:
         sc.prev_pair_normal_force[i] = s.pair_normal_force[i]
         sc.prev_pair_overlap[i] = s.pair_overlap[i]
         sc.prev_pair_set[i] = s.pair_set[i]
+        sc.prev_pair_weight[i] = sc.pair_weight[i]
         for k in range(3):
             sc.prev_pair_shear[i, k] = s.pair_shear[i, k]
             sc.prev_pair_normal[i, k] = s.pair_normal[i, k]

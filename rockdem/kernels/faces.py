@@ -29,9 +29,10 @@ from .polygon import clip_edge, clip_halfplane, deepest_point, nearest_on_polygo
 INSIDE_TOL = 1e-10
 """[m] a cell vertex this close outside a target edge counts as inside (round-off of flush joints)."""
 
-DEPTH_TIE = 1e-7
-"""[m] the least depth band of a covered cell's deepest point (a cell whose vertices are all this
-close in depth: a flat joint)."""
+DEPTH_TIE = 1.0
+"""The least depth band of a covered cell's deepest point, in touching tolerances: the vertices
+this close in depth to the deepest share it, so that on a cell pressed flat it slides along the
+cell as its ends' depths cross instead of jumping from end to end (docs/contacts.md section 2)."""
 
 DEPTH_BLEND = 0.1
 """Covered-cell vertices within this share of the cell's depth range of the deepest share its
@@ -380,7 +381,7 @@ def _cover_tail(
         inv = 1.0 / fm.det
         gu = inv * (fm.hu * fm.m11 - fm.hw * fm.m10)  # height above the target plane in target coordinates
         gw = inv * (-fm.hu * fm.m01 + fm.hw * fm.m00)
-        du_, dw_ = deepest_point(buf, cur, n, gu, gw, DEPTH_BLEND, DEPTH_TIE)
+        du_, dw_ = deepest_point(buf, cur, n, gu, gw, DEPTH_BLEND, DEPTH_TIE * touch_tol)
         gain = gu * (nu_ - du_) + gw * (nw_ - dw_)
         uncovered = 1.0 - area / point_area
         # A point off the target is no interface point of this contact any more: the farther off

@@ -222,8 +222,9 @@ def cover_change(
     set by as much (the spring keeps its energy), one it makes shallower lowers the set first and
     releases the rest (dissipated, returned). Compressed at both steps, a growing area keeps both
     springs' energies: the set rises so that kn A u^2 / 2 is that of the last area, and the shear
-    extension is scaled so that ks A u_s^2 / 2 is (the factor returned); a shrinking one loses
-    (kn u^2 + ks u_s^2) (A_prev - A) / 2. The set follows the overlap down, to 0 once it opens.
+    extension is scaled so that ks A u_s^2 / 2 is (the factor returned); a shrinking one lowers the
+    set first, as far as it keeps kn A u^2 / 2, and loses the rest and ks u_s^2 (A_prev - A) / 2.
+    The set follows the overlap down, to 0 once it opens.
     (Without the shear's part a corner of a random hull sinking into a face at 3 m/s, its cell's
     cover growing fivefold, gained 3.6 J of shear spring energy without work, docs/contacts.md section 5.)"""
     st = slot_set[p, j]
@@ -247,7 +248,14 @@ def cover_change(
             st += un - kept
             un = kept
         elif area < prev_area:
-            e += 0.5 * (kn * un * un + ks * us_sq) * (prev_area - area)
+            # The set comes down first, so that kn A u^2 / 2 is that of the last area (a cover
+            # sliding to and fro gives back what it took: a one-way set sank a parapet's brick 4 mm
+            # into the one below as its blended pair's cover moved at every vibration); the rest,
+            # and the shear spring's share, is dissipated.
+            before = un
+            un = min(un * math.sqrt(prev_area / area), un + st)
+            st -= un - before
+            e += 0.5 * kn * (prev_area * before * before - area * un * un) + 0.5 * ks * us_sq * (prev_area - area)
     elif st > 0.0 and un < 0.0:
         st = max(st + un, 0.0)  # opened: the set comes down to the geometric overlap st + un, or 0
     slot_set[p, j] = st
@@ -419,6 +427,7 @@ def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, implicit
     # A pair formed from an EDGE pair runs its law twice at its first pass when its
     # sub-contacts would hold more than the edge spring held (_hand_over_face).
     for _ in range(2):
+        lam_prev = sc.pair_weight[i]  # the target's share at the last law pass (-1: not known)
         lam, dlam = _blend(m, s, sc, i, fa, fb, a, b, split)
         # The owner's points on the target face, then (while the pair may blend) the target's on
         # the owner face: one call site, so that the inlined joint law is compiled once.
@@ -426,9 +435,11 @@ def _law_pair(m: ModelArrays, s: State, sc: Scratch, i: int, dt: float, implicit
         for side in range(2 if split < stop else 1):
             if side == 0:
                 k0, k1, fo, ft, o, t, wgt, blending = s.pair_track_start[i], split, fa, fb, a, b, 1.0 - lam, split < stop
+                wgt_prev = 1.0 - lam_prev if lam_prev >= 0.0 else -1.0
             else:
                 k0, k1, fo, ft, o, t, wgt, blending = split, stop, fb, fa, b, a, lam, True
-            u_side = _law_range(m, s, sc, i, side, k0, k1, fo, ft, o, t, wgt, blending, dt, implicit, dashpots, buf)
+                wgt_prev = lam_prev
+            u_side = _law_range(m, s, sc, i, side, k0, k1, fo, ft, o, t, wgt, wgt_prev, blending, dt, implicit, dashpots, buf)
             if side == 0:
                 u_owner = u_side
             elif dlam != 0.0:
@@ -681,15 +692,16 @@ def _open_cell_touch(
 @njit(cache=True, _nrt=False, inline="always")
 def _law_range(
     m: ModelArrays, s: State, sc: Scratch, i: int, side: int, k0: int, k1: int, fo: int, ft: int, o: int, t: int,
-    wgt: float, blending: bool, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray,
+    wgt: float, wgt_prev: float, blending: bool, dt: float, implicit: bool, dashpots: bool, buf: np.ndarray,
 ) -> float:
     """The joint law of sub-contacts track[k0:k1] of FACE pair i: points of face ``fo`` (block o)
     pressed on face ``ft`` (block t), carrying the share ``wgt`` (kernels.blend; ``blending``
-    False: the whole pair, wgt 1). With ``implicit`` dashpots (:mod:`rockdem.kernels.implicit`) only
+    False: the whole pair, wgt 1); ``wgt_prev``: the share their areas held at the last law pass
+    (1 for the whole pair, -1 not known). With ``implicit`` dashpots (:mod:`rockdem.kernels.implicit`) only
     half the dashpot force at the last half step's velocity is applied here and each active
     dashpot is stored (``sc.dashpot_*``) for the velocity solve. Leaves the side's resultant on
     block o (moment about its centroid), energies and counts in ``sc.side_*[i, side]``; returns
-    the normal spring energy at full share."""
+    the normal springs' energy at full share [J]."""
     elastic = 0.0
     active = 0
     e_fric = 0.0
@@ -704,6 +716,8 @@ def _law_range(
     # period 2 pi / omega_max of the stiffest contact): five static overlaps g / omega_max^2.
     impact_depth = impact_speed * s.impact_window[0] / (2.0 * math.pi) if s.impact_window[0] > 0.0 else np.inf
     sf0 = sf1 = sf2 = sm0 = sm1 = sm2 = 0.0
+    # How the side's share moved since the last law pass (1: not at all, or not known).
+    share = (wgt if blending else 1.0) / wgt_prev if wgt_prev > 0.0 else 1.0
     fm = face_map_arrays(m.face_block, m.face_origin, m.face_u, m.face_w, m.face_normal, sc.rotation, s.position, fo, ft)
     # The cover of each cell (its effective area and force point, kernels.faces): the target's edge
     # lines that cross the owner face are found once for the pair; with none every cell is wholly
@@ -803,8 +817,12 @@ def _law_range(
             # 2026-11-28). It keeps its energy as the area grows or w deepens it (its overlap is
             # measured from a set, s.slot_set, which follows the overlap down as it opens) and
             # what it holds less as they shrink it is dissipated (an ended stiffening is booked
-            # above: the areas are compared at the same factor). Inside a blend the area's change
-            # comes with the blend weight's, whose energy gradient is applied (kernels.blend): only w's is.
+            # above: the areas are compared at the same factor). Inside a blend the areas are
+            # compared at the same share too: the share's own change is the blend weight's, whose
+            # energy gradient is applied (kernels.blend); a cell's cover changing while it carries a
+            # share is this rule's (a random hull's corner sinking into a face carried by the target
+            # face's points, its cut cell's area shrinking, created 16 J of a pile's 300 J, before
+            # 2026-12-07). A pair new at this detection (share not known) inside a blend counts w's only.
             # (A wholly covered cell has a set when its pair took over from an edge, _hand_over_face.)
             # The cover deepens the cell by the overlap now less the overlap it would have now with
             # the last step's cover weight, anchor and deepest vertex (faces.anchored_overlap): the
@@ -821,8 +839,10 @@ def _law_range(
                 deepened = anchored_overlap(fm, nu, nw, au, aw, eu, ew, cover_w, m.touch_tol) - anchored_overlap(
                     fm, nu, nw, s.slot_anchor[p, j, 0], s.slot_anchor[p, j, 1], s.slot_deepest[p, j, 0],
                     s.slot_deepest[p, j, 1], s.slot_cover[p, j], m.touch_tol)
-            un, e_set, shear_factor = cover_change(s.slot_set, p, j, un, un_prev, area, prev_area / ended, kn, deepened,
-                                        cut and not blending, ks, us0 * us0 + us1 * us1 + us2 * us2)
+            area_then = prev_area / ended * share  # at the factor and share of this step
+            un, e_set, shear_factor = cover_change(s.slot_set, p, j, un, un_prev, area, area_then, kn, deepened,
+                                        cut and (wgt_prev > 0.0 or (wgt_prev < 0.0 and not blending)), ks,
+                                        us0 * us0 + us1 * us1 + us2 * us2)
             us0 *= shear_factor
             us1 *= shear_factor
             us2 *= shear_factor
@@ -898,6 +918,18 @@ def _law_range(
             since = min(un / (-vn * dt), 1.0) * dt
             ramp = ramp_overlap(un, un_prev, vn, dt) / un
         f_applied = fn * ramp
+        if share > 1.0:
+            # The side's share grew (kernels.blend): the shear spring keeps its energy, as for a
+            # growing cover (cover_change), its extension scaled; ...
+            f = 1.0 / math.sqrt(share)
+            us0 *= f
+            us1 *= f
+            us2 *= f
+        elif share < 1.0:
+            # ... as it shrinks, what the spring holds less is dissipated. (The normal springs'
+            # share moves with the weight's energy gradient instead; with the shear springs' energy
+            # in that gradient a block 5 mm past a support's edge rested on the barrier it raises.)
+            e_fric += 0.5 * ks * area * (1.0 / share - 1.0) * (us0 * us0 + us1 * us1 + us2 * us2)
         us0, us1, us2, e0_du, e0_sq, du_sq = shear_increment(us0, us1, us2, n0, n1, n2, vs0, vs1, vs2, since)
         if bonded:
             fmax = coulomb_limit(m.mat_cohesion[go, gt], m.mat_tan_friction[go, gt], area, fn)

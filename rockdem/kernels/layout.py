@@ -261,7 +261,8 @@ class Scratch(NamedTuple):
     pair_dashpot_cn: np.ndarray  # (P,) [N s/m] EDGE pairs: normal dashpot, 0 inactive
     pair_dashpot_cs: np.ndarray  # (P,) [N s/m] EDGE pairs: shear dashpot
     pair_dashpot_velocity: np.ndarray  # (P, 3) [m/s] EDGE pairs: relative velocity of a to b at the last half step
-    pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it
+    pair_weight: np.ndarray  # (P,) FACE: share of the target face's points (kernels.blend), the owner's 1 - it;
+    # from a detection to the pair's law pass the share it had at its last law pass (-1: a new pair)
     pair_bonded: np.ndarray  # (P,) bool FACE: every sub-contact was bonded at the last detection (weight 0)
     pair_asks_detection: np.ndarray  # (P,) bool FACE: its target's points are needed but not tracked (law pass to gather)
     pair_handover: np.ndarray  # (P,) [J] FACE formed at this detection from an EDGE pair, or from a FACE pair
@@ -316,6 +317,7 @@ class Scratch(NamedTuple):
     prev_pair_normal_force: np.ndarray  # (P,)
     prev_pair_overlap: np.ndarray  # (P,)
     prev_pair_set: np.ndarray  # (P,)
+    prev_pair_weight: np.ndarray  # (P,) pair_weight at the last law pass (-1: not known)
     prev_pair_key: np.ndarray  # (P,) int64 key a nb + b of each previous pair
     prev_pair_index: np.ndarray  # (P,) int64 the previous pairs in ascending key order
     prev_pair_kept: np.ndarray  # (P,) bool the previous pair was found again, as the same contact
