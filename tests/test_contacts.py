@@ -317,9 +317,11 @@ def test_a_flat_cells_deepest_point_moves_continuously_as_its_ends_cross():
     end: a jump at a fixed pose is a cover change that goes into the cell's set while the force
     point moves, and the step's work then falls short of what the spring holds at each turn of
     the twist. With the vertices within 1e-7 m of the deepest sharing the point (before
-    2026-12-07) it jumped the cell's 0.5 m length within a 5e-7 m change of the ends' depths; a
-    two-block wall's crack (Poisson 0.45, undamped) lost 1.3 % of its energy scale at such turns.
-    Now the band is the touching tolerance: the point moves in proportion to the depths."""
+    2026-12-07) it jumped 0.25 m, from an end to the middle, within a 2e-7 m change of the ends'
+    depths; a two-block wall's crack (Poisson 0.45, undamped, with the symmetric sets of
+    forces.cover_change) lost 1.28 % of its energy scale at such turns, 0.40 % with the band's
+    floor. Now the band is at least the touching tolerance: the point moves in proportion to the
+    depths."""
     from rockdem.kernels.faces import FaceMap, partly_covered
 
     touch = 2e-4
