@@ -564,10 +564,15 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
                    impact_refinement: float | None = None) -> _Run:
     """The run saved in ``ck``, continued to ``duration``: its state, frames and snapshots."""
     ck.check_model(model)
-    given = {"dt": (dt, ck.timestep.dt if ck.timestep.rule == "user" else None),
-             "timestep_rule": (rule, ck.timestep.rule if ck.timestep.rule != "user" else None),
+    # A rule and a resolution that the saved run did not use are not compared: beside a given dt
+    # the rule had no part, and the resolution has none outside the bound rule (the command line
+    # passes the case's defaults of both; its printed "continue with" failed on them before 2026-12-08).
+    user = ck.timestep.rule == "user"
+    given = {"dt": (dt, ck.timestep.dt if user else None),
+             "timestep_rule": (None if user else rule, None if user else ck.timestep.rule),
              "safety": (safety, float(ck.state.safety[0])),
-             "resolution": (resolution, float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
+             "resolution": (resolution if ck.timestep.rule == "bound" else None,
+                            float(ck.state.resolution[0]) if ck.timestep.rule == "bound" else None),
              "impact_refinement": (impact_refinement, float(ck.state.refinement[0])),
              "dashpots": (None if dashpots is None else resolve_dashpots(model, dashpots), ck.timestep.dashpots),
              "record_interval": (record_interval, ck.record_interval),

@@ -143,8 +143,12 @@ def test_settled_state_starts_new_loadings_at_rest(tmp_path):
     np.testing.assert_array_equal(other.block_position.values[0], settled.state.position)
 
 
-def test_cli_run_from_checkpoint_equals_one_run(tmp_path):
-    args = ["run", "--example", "free-rocking", "--quiet", "--no-plot", "--set", "run.record_interval=0.01"]
+@pytest.mark.parametrize("options", [[], ["run.dt=2e-4"], ['run.timestep_rule="3dec"']], ids=["automatic", "dt", "3dec"])
+def test_cli_run_from_checkpoint_equals_one_run(tmp_path, options):
+    # also with a step or rule of the user's: the command line passes the case's default rule and
+    # resolution, which such a run does not use (refused as changed options before 2026-12-08)
+    args = ["run", "--example", "free-rocking", "--quiet", "--no-plot", "--set", "run.record_interval=0.01",
+            *[a for o in options for a in ("--set", o)]]
     assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "one")]) == 0
     assert main(args + ["--duration", "0.2", "--out", str(tmp_path / "two")]) == 0
     ck = tmp_path / "two" / "checkpoint.npz"
@@ -152,6 +156,7 @@ def test_cli_run_from_checkpoint_equals_one_run(tmp_path):
     assert_identical(load(tmp_path / "one" / "result.nc"), load(tmp_path / "two" / "result.nc"))
     assert main(args + ["--duration", "0.4", "--out", str(tmp_path / "three"), "--from", str(ck), "--settled", str(ck)]) == 2
     assert main(args + ["--set", "damping.beta=0.002", "--out", str(tmp_path / "four"), "--from", str(ck)]) == 2
+    assert main(args + ["--set", "run.dt=1e-4", "--out", str(tmp_path / "five"), "--from", str(ck)]) == 2  # another step
 
 
 def test_settled_state_starts_an_earthquake_case(tmp_path):
