@@ -470,6 +470,11 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         raise ValueError(f"record_interval = {interval:g} s puts {info.dt / interval:.3g} frames in each time step "
                          f"({info.dt:.4g} s), all interpolated between the same two steps (more than {FRAMES_PER_STEP}); "
                          f"give record_interval >= {info.dt / FRAMES_PER_STEP:.3g} s, or the step itself")
+    if snaps.interval is not None and snaps.interval < info.dt:
+        # (below the step it took one snapshot per step at best; at 1e-12 s the clock stopped, the
+        # snapshots piling up in memory, before 2026-12-08)
+        raise ValueError(f"contact_interval = {snaps.interval:g} s is shorter than the time step ({info.dt:.4g} s): contact "
+                         f"snapshots are taken at steps, one per step at most; give contact_interval >= {info.dt:.4g} s")
     _check_motions(model, info.dt, duration)
     rec = _frames(model, duration, interval)
     if start is not None:

@@ -644,6 +644,16 @@ def test_frames_far_closer_than_a_step_are_refused():
         run_case(parse_case(data))
 
 
+def test_contact_snapshots_closer_than_a_step_are_refused():
+    # one snapshot per step at best; at 1e-12 s the clock stopped while snapshots piled up in memory
+    from rockdem.run_cli import run_case
+
+    data = example_case("free-rocking")
+    data["run"].update(duration=0.05, contact_interval=1e-12)
+    with pytest.raises(ValueError, match=r"contact_interval = 1e-12 s is shorter than the time step .* give contact_interval >="):
+        run_case(parse_case(data))
+
+
 def _slider_model(speed: float, seconds: float):
     """A cube resting on the ground and, beside it, a driven block moving at ``speed`` [m/s] along x
     for ``seconds`` [s]."""
