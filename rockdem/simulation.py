@@ -250,6 +250,8 @@ def run_model(
         checkpoint_every = _positive_number("checkpoint_every", checkpoint_every, "s of wall time")
         if checkpoint is None:
             raise ValueError("checkpoint_every needs a checkpoint file: give checkpoint=PATH")
+    if checkpoint is not None:
+        _check_checkpoint_path(checkpoint)
     mon = _check_monitors(model, monitors or {})
     rule = stop_rule(stop)
     n_threads = _threads(threads, model.block_count)
@@ -603,6 +605,25 @@ def _continued_run(model: Model, duration: float, ck: Checkpoint, dt: float | No
     snaps.restore(ck.snapshots, ck.snapshot_count)
     return _Run(ck.timestep, state, scratch, rec, ck.frame, ck.record_interval, snaps, ck.time, ck.runtime_s, ck.time,
                 ck.check_target)
+
+
+def _check_checkpoint_path(path: str | os.PathLike[str]) -> None:
+    """Refuse, before the run, a checkpoint path that cannot be written: a folder, a path under a
+    file, or a folder without write permission (the file and its missing folders are made when it
+    is saved; a refusal there came as an OSError after the whole run, its result lost)."""
+    try:
+        p = Path(path)
+    except TypeError:
+        raise ValueError(f"checkpoint must be a file path, got {path!r}") from None
+    if p.is_dir():
+        raise ValueError(f"checkpoint = {str(p)!r} is a folder; give a file path in it, e.g. {str(p / 'checkpoint.npz')!r}")
+    folder = p.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise ValueError(f"checkpoint = {str(p)!r} lies under {str(folder)!r}, which is a file, not a folder; give another path")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"checkpoint = {str(p)!r}: no permission to write in {str(folder)!r}; give another path")
 
 
 class _Saver:

@@ -110,6 +110,18 @@ def test_checkpoint_refuses_another_model_or_other_options(case, tmp_path):
     assert simulate(case.model, 0.1 + interval, initial=tmp_path / "c.npz", progress=False).time.values[-1] == pytest.approx(0.1 + interval)
 
 
+def test_a_checkpoint_path_that_cannot_be_written_is_refused_before_the_run(case, tmp_path, monkeypatch):
+    # refused after the whole run before 2026-12-08 (IsADirectoryError, FileExistsError), the result lost
+    ran = []
+    monkeypatch.setattr(simulation, "_load_kernels", lambda *a: ran.append(a))  # (nothing must be run)
+    (tmp_path / "afile").write_text("x")
+    for path, match in ((tmp_path, "is a folder; give a file path in it"),
+                        (tmp_path / "afile" / "c.npz", "which is a file, not a folder")):
+        with pytest.raises(ValueError, match=match):
+            simulate(case.model, 0.05, checkpoint=path, progress=False)
+    assert not ran
+
+
 def test_checkpoint_of_another_engine_layout_is_refused_by_name(case, tmp_path):
     simulate(case.model, 0.05, checkpoint=tmp_path / "c.npz", **RUN)
     with np.load(tmp_path / "c.npz") as z:
