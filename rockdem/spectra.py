@@ -25,6 +25,12 @@ __all__ = ["DEFAULT_PERIODS", "Spectrum", "response_spectrum", "plot_record", "p
 DEFAULT_PERIODS: NDArray[np.float64] = np.geomspace(0.02, 5.0, 80)
 """Oscillator periods [s] of the default spectrum (log-spaced, 0.02 to 5 s)."""
 
+SPECTRUM_MAX_SAMPLES = 20_000_000
+"""Most samples of one oscillator's response that :func:`response_spectrum` computes (pyrotd refines
+the record's Fourier grid to five times the oscillator's frequency): a record of a few hundred
+seconds at any ordinary dt needs well under a million; a dt off by orders of magnitude (1e-9 or
+1e5 s) needed terabytes or ran for hours, and is refused."""
+
 
 @dataclass(frozen=True, repr=False)
 class Spectrum:
@@ -101,6 +107,13 @@ def response_spectrum(
     # each oscillator's free vibration after the record decays (to e^-5 = 0.7 %) instead of wrapping
     # round onto the record's start (without them PSA was 20 to 25 % off at T = 2 to 5 s).
     tail = 5.0 / (max(damping, SPECTRUM_MIN_DECAY) * 2.0 * np.pi / float(t.max()))
+    n = motion.acceleration.size + np.ceil(tail / motion.dt)  # (a float: tail / dt may be huge)
+    need = 2.0 * max(n / 2.0 + 1.0, 5.0 * n * motion.dt / float(t.min()))  # pyrotd's irfft of the shortest period
+    if need > SPECTRUM_MAX_SAMPLES:
+        raise ValueError(
+            f"{motion.name or 'the record'}: its response spectrum from T = {float(t.min()):g} s to {float(t.max()):g} s "
+            f"at dt = {motion.dt:g} s would compute {need:.3g} samples per oscillator (at most {SPECTRUM_MAX_SAMPLES:.0e}): "
+            "check the record's dt (recorded ground motions are sampled every 0.001 to 0.05 s)")
     acc = np.concatenate([motion.acceleration, np.zeros(int(np.ceil(tail / motion.dt)))])
     res = pyrotd.calc_spec_accels(motion.dt, acc, 1.0 / t, osc_damping=damping)
     return Spectrum(t.copy(), np.abs(np.asarray(res.spec_accel, dtype=float)), float(damping), motion.name)

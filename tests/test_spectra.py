@@ -3,6 +3,7 @@ record plots, and the input motion drawn under the response of earthquake runs."
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,11 @@ def test_spectrum_errors():
         response_spectrum(gm, [0.0, 1.0])
     with pytest.raises(ValueError, match="damping"):
         response_spectrum(gm, damping=5.0)
+    # a dt off by orders of magnitude: 593 GiB of padding at 1e-9 s, hours in pyrotd at 1e5 s (before 2026-12-08)
+    few = GroundMotion(np.array([0.1, 0.2, -0.3, 0.5, 0.0]), dt=1e-9, name="few")
+    for dt in (1e-9, 1e5):
+        with pytest.raises(ValueError, match=rf"few: its response spectrum .* at dt = {dt:g} s would compute .* check the record's dt"):
+            response_spectrum(dataclasses.replace(few, dt=dt))
 
 
 def test_records_plot_command(tmp_path, capsys):
