@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._warn import warn_user
 from .kernels.bound import contact_bound
 from .kernels.contact import sp_critical_factor
 from .kernels.step import IMPACT_SHARE
@@ -53,6 +54,10 @@ from .state import initial_state
 __all__ = ["TimestepInfo", "stable_timestep", "DEFAULT_SAFETY", "DEFAULT_RESOLUTION", "QUAKE_RESOLUTION",
            "DASHPOT_SCHEMES", "resolve_dashpots", "dashpot_code", "MAX_DAMPING_RATIO", "IMPACT_REFINEMENT", "IMPACT_SHARE",
            "impact_windows"]
+
+USER_DT_SHARE = 1e-3
+"""A user dt below this share of the stable bound is warned about: it only multiplies the steps
+(run.dt = 1e-9 s on a free-rocking block planned 1e8 steps without a word, before 2026-12-08)."""
 
 DASHPOT_SCHEMES = ("auto", "implicit", "explicit")
 """How SP dashpots are integrated: "implicit" (trapezoidal, stable at the undamped step,
@@ -265,6 +270,10 @@ def stable_timestep(
                 f"(omega_max = {om:.4g} rad/s, SP reduction {fac:.4f}); use dt <= {critical:.3e} s "
                 "or leave dt unset for the automatic value"
             )
+        if dt < USER_DT_SHARE * critical:
+            warn_user(f"dt = {dt:.3e} s is {critical / dt:.3g} times below the stable bound {critical:.3e} s of this model: "
+                      f"the run takes that many times the steps it needs (the automatic step resolves impacts); "
+                      f"leave dt unset, or give a dt nearer the bound (a convergence check needs a tenth of it)")
         return TimestepInfo(float(dt), critical, om, fac, "user", dashpots=dashpots, damping_ratio=xi)
     if rule == "3dec":
         m = model.arrays

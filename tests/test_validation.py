@@ -169,6 +169,11 @@ def test_dt_above_the_stable_bound_is_refused_with_the_bound():
     with pytest.raises(ValueError, match=f"above the stable bound {bound:.3e} s"):
         simulate(model, 0.1, dt=1.01 * bound)
     simulate(model, 0.01, dt=0.99 * bound)  # just below is accepted
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        stable_timestep(model, dt=0.1 * bound)  # a convergence check's tenth: no warning
+    with pytest.warns(UserWarning, match=r"dt = 1.000e-09 s is [\d.e+]+ times below the stable bound .* leave dt unset"):
+        stable_timestep(model, dt=1e-9)  # (1e8 steps for 0.1 s, without a word before 2026-12-08)
 
 
 def test_missing_material_and_no_free_block():
