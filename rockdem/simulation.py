@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import operator
 import os
 import signal
 import sys
@@ -965,7 +966,12 @@ def _check_monitors(model: Model, monitors: Mapping[str, Monitor]) -> dict[str, 
             ) from None
         if not np.all(np.isfinite(p)):
             raise ValueError(f"monitor {name!r}: the point (x, y, z) must be finite [m], got {tuple(p.tolist())}")
-        b = model.block_id(blk) if isinstance(blk, str) else int(blk)
+        try:
+            b = model.block_id(blk) if isinstance(blk, str) else operator.index(blk)
+        except KeyError as exc:  # (raised as a KeyError from here before 2026-12-08)
+            raise ValueError(f"monitor {name!r}: {exc.args[0]}") from None
+        except TypeError:
+            raise ValueError(f"monitor {name!r}: give its block by name or id, got {blk!r}") from None
         if not 0 <= b < model.block_count:
             raise ValueError(f"monitor {name!r}: block id {b} out of range")
         out[str(name)] = (b, p)

@@ -555,6 +555,16 @@ def test_a_monitor_point_must_be_finite(point):
         simulate(b.finalize(), 0.01, monitors={"top": ("block", point)}, progress=False)
 
 
+@pytest.mark.parametrize(("block", "match"), [("nope", r"monitor 'top': no block named 'nope'; blocks are \['ground', 'block'\]"),
+                                              (1.5, "monitor 'top': give its block by name or id, got 1.5"),
+                                              (7, "monitor 'top': block id 7 out of range")])
+def test_a_monitor_on_a_block_that_is_not_there_is_refused_by_name(block, match):
+    b = _builder()
+    b.add_box(0.2, 0.5, 1.0, density=2000, name="block")
+    with pytest.raises(ValueError, match=match):
+        simulate(b.finalize(), 0.01, monitors={"top": (block, (0.0, 0.0, 1.0))}, progress=False)
+
+
 def test_doubtful_values_are_warned_about():
     """A residual friction angle above the peak one, a contact tolerance of the blocks' size and
     free rocking without gravity run, with a warning that says why they are doubtful."""
