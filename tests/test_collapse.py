@@ -205,6 +205,38 @@ def test_the_step_resolves_a_corner_landing_whatever_the_interface_points():
     assert steps[1] == pytest.approx(steps[0], rel=1e-9) and steps[2] == pytest.approx(steps[0], rel=1e-9)
 
 
+@pytest.mark.parametrize("points", [(2, 2), (3, 3)])
+def test_a_column_released_on_any_of_its_corners_rocks_alike(points):
+    # A corner resting alone at the start is a landing at its start depth (docs/contacts.md,
+    # section 2): a square column tilted towards each of its four diagonals rests on one corner,
+    # whose overlap at the start is 0 up to round-off of either sign. Before 2026-12-08 the sign
+    # decided: with 2 x 2 points three corners kept their own cell's stiffness (kn A / 4), one got
+    # the face's, the step differed by 2 x and the centroid's settlement by 74 um at 0.05 s (3 x 3:
+    # 4 x and 0.37 mm at 0.3 s). (The round-off's sign still decides whether the corner's dashpot
+    # acts in the first step: 0.3 um in the first step, 1.4 nm at 0.05 s.)
+    from rockdem.materials import JointMaterial
+    from rockdem.model import Damping, ModelBuilder
+
+    def column(direction, lift=0.0):
+        b = ModelBuilder(points=points)
+        b.default_material = JointMaterial.from_modulus(1.8e9, 1.5, friction_angle=80)
+        b.add_box(4, 4, 0.5, base_center=(0, 0, -0.5), driven=True, name="ground")
+        b.add_box(0.3, 0.3, 1.5, base_center=(0, 0, lift), density=2000, name="col")
+        b.tilt("col", 0.8, direction=direction)
+        return b.finalize(damping=Damping(beta=0.0175))
+
+    heights, steps = [], []
+    for direction in [(1, 1, 0), (-1, 1, 0), (-1, -1, 0), (1, -1, 0)]:
+        ds = simulate(column(direction), 0.05, record_interval=0.002, progress=False)
+        heights.append(ds.block_position.sel(block="col").values[:, 2])
+        steps.append(ds.attrs["dt"])
+    for z, dt in zip(heights[1:], steps[1:]):
+        assert dt == pytest.approx(steps[0], rel=1e-12)
+        assert abs(z[-1] - heights[0][-1]) < 1e-8
+    # ... and its step is that of the same corner about to land (0.1 mm above the ground): the face's.
+    assert steps[0] == pytest.approx(stable_timestep(column((1, 1, 0), lift=1e-4)).dt, rel=1e-9)
+
+
 def test_an_edge_landing_keeps_its_corner_springs():
     # An edge landing flat (the paper's rocking impact on the two corner springs of 2 x 2 points) is
     # not stiffened: its overlap is v sqrt(m_eff / (2 kn A_cell)).

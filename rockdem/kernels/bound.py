@@ -24,7 +24,7 @@ from .contact import sp_critical_factor
 from .faces import face_map
 from .forces import flexibility as _flex
 from .forces import landing_corner
-from .layout import DASHPOTS_IMPLICIT, PAIR_EDGE, SLOTS, ModelArrays, Scratch, State
+from .layout import DASHPOTS_IMPLICIT, PAIR_EDGE, SLOTS, STIFFENING_AT_START, ModelArrays, Scratch, State
 
 
 @njit(cache=True, _nrt=False, inline="always")
@@ -126,7 +126,8 @@ def contact_bound(m: ModelArrays, s: State, sc: Scratch, sp_reduction: bool) -> 
             # it; its stiffening never exceeds what the step at its landing resolves.
             j = s.track[k] - SLOTS * p
             stiff = s.slot_stiffening[p, j]
-            if m.point_corner[p] >= 0 and not s.slot_bonded[p, j] and (s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0):
+            if m.point_corner[p] >= 0 and not s.slot_bonded[p, j] and (
+                    s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0 or stiff == STIFFENING_AT_START):
                 fm = fm0 if k < split else fm1
                 stiff = landing_corner(m, p, m.point_face[p], ft, fm.h0, fm.hu, fm.hw) if s.dashpots[0] == DASHPOTS_IMPLICIT else 1.0
             r_o, r_t = _contact_rows(m, s, sc, beta, o, t, x0, x1, x2, n0, n1, n2, m.point_area[p] * stiff)

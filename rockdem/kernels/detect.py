@@ -37,6 +37,7 @@ from .layout import (
     PAIR_EDGE,
     PAIR_FACE,
     SLOTS,
+    STIFFENING_AT_START,
     ModelArrays,
     Scratch,
     State,
@@ -1021,7 +1022,8 @@ def bond_touching(m: ModelArrays, s: State, sc: Scratch) -> None:
     """At the start: the effective area and overlap of every tracked sub-contact, bonded where its
     cell is covered and its gap is within ``m.touch_tol`` and the two groups' material bonds
     (``m.mat_bonded``); a FACE pair whose sub-contacts are all bonded is a joint
-    (``sc.pair_bonded``, no blending)."""
+    (``sc.pair_bonded``, no blending). An unbonded corner sub-contact touching is marked
+    STIFFENING_AT_START (its corner stiffening decided at the first law pass)."""
     for i in range(s.pair_count[0]):
         if s.pair_kind[i] != PAIR_FACE:
             continue
@@ -1043,6 +1045,10 @@ def bond_touching(m: ModelArrays, s: State, sc: Scratch) -> None:
             s.slot_bonded[p, j] = touching and m.mat_bonded[m.block_group[m.point_block[p]], m.block_group[s.slot_partner[p, j]]]
             s.slot_area[p, j] = area
             s.slot_overlap[p, j] = -gap
+            if touching and not s.slot_bonded[p, j] and m.point_corner[p] >= 0:
+                # A corner resting alone at the start is a landing at its start depth, whichever
+                # sign the round-off gives its overlap (kernels.forces.corner_stiffening).
+                s.slot_stiffening[p, j] = STIFFENING_AT_START
         joint = k1 > k0
         for k in range(k0, k1):
             p = s.track[k] // SLOTS

@@ -42,6 +42,7 @@ from .layout import (
     LAW_CHUNKS,
     PAIR_EDGE,
     SLOTS,
+    STIFFENING_AT_START,
     ModelArrays,
     Scratch,
     State,
@@ -195,9 +196,13 @@ def corner_stiffening(
     EDGE pair at the last detection (``s.pair_from_edge[i]``) continue that contact and are not
     stiffened (as landing corners, 0.18 mm deep, they held 12.8 J where the edge spring had held
     1.7 J). Bonded sub-contacts are never stiffened, nor any with explicit dashpots (whose step is
-    bounded by Belytschko's factor, not the resolution)."""
-    if s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0:
-        # Decided at the step it presses (still open: nothing acts, the bound uses landing_corner).
+    bounded by Belytschko's factor, not the resolution). A corner touching at the start
+    (STIFFENING_AT_START, kernels.detect.bond_touching) is decided at the first pass as one that
+    arrives at its start depth: the sign of a round-off overlap chose before (a column released
+    on one corner: three of its four corners unstiffened, 2026-12-08)."""
+    if s.slot_area[p, j] == 0.0 or s.slot_overlap[p, j] <= 0.0 or s.slot_stiffening[p, j] == STIFFENING_AT_START:
+        # Decided at the step it presses (still open: nothing acts, the bound uses landing_corner),
+        # or at the first pass for a corner touching at the start (its overlap is round-off's).
         if depth <= 0.0:
             return 1.0
         return _classify_corner(m, s, sc, i, p, j, fo, ft, o, t, h0, hu, hw, before, x0, x1, x2, n0, n1, n2)

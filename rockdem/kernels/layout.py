@@ -35,6 +35,11 @@ answer does not depend on how many there are."""
 SLOTS = 2
 """Partners a point can hold at once (a point on the shared edge of two faces of its partners)."""
 
+STIFFENING_AT_START = 0.0
+"""``State.slot_stiffening`` of an unbonded corner sub-contact touching at the start: its factor is
+decided at the first law pass as for a corner arriving at its start depth (kernels.forces.corner_stiffening),
+whatever the sign of a round-off overlap."""
+
 # How the SP dashpots are integrated (State.dashpots).
 DASHPOTS_IMPLICIT = 0  # trapezoidal in the damping: stable at the undamped step (kernels.implicit)
 DASHPOTS_EXPLICIT = 1  # on the last half step's velocities, Belytschko-reduced step (3DEC's scheme)
@@ -187,6 +192,7 @@ class State(NamedTuple):
     slot_deepest: np.ndarray  # (np, SLOTS, 2) [m] (u, w) its deepest covered point, likewise
     slot_bonded: np.ndarray  # (np, SLOTS) bool
     slot_stiffening: np.ndarray  # (np, SLOTS) [-] area factor of a corner that landed alone (vertex-face contact), 1 otherwise
+    # (STIFFENING_AT_START: to be decided at the first law pass)
     point_failed: np.ndarray  # (np,) int64 FAILED_*
     energy: np.ndarray  # (ENERGY_COUNT,) [J] accumulated dissipation and work
     track: np.ndarray  # (SLOTS np,) int64 contact codes 2 p + k, grouped by pair
