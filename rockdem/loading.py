@@ -759,6 +759,11 @@ def _horizontal_unit(direction: ArrayLike, gravity: NDArray[np.float64], what: s
 # -- TOML loading types ------------------------------------------------------------------------
 
 
+RECORD_DT_RANGE = (1e-4, 0.1)
+"""[s] the sampling steps of recorded ground motions, widely (0.001 to 0.05 s in the archives); a record
+outside is warned about (a dt of 1e-9 s ended in an error about the foundation's path, before 2026-12-08)."""
+
+
 def _read_table_record(t: Table, key: str, units: str | None, dt: float | None, columns: tuple[int | None, int | None]) -> GroundMotion:
     """The record file of key ``key`` of a loading table, read with the table's units, dt and columns;
     a file that cannot be read is refused with the table's keys that tell how to read it."""
@@ -793,6 +798,10 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
     dt = t.optional_number("dt", positive=True)
     columns = tuple(t.integer(key) if key in t.data else None for key in ("time_column", "acc_column"))
     gm = _read_table_record(t, "record", units, dt, columns)
+    if not RECORD_DT_RANGE[0] <= gm.dt <= RECORD_DT_RANGE[1]:
+        warn_user(f"[{t.where}] record {t.string('record')!r}: dt = {gm.dt:g} s lies far outside the {RECORD_DT_RANGE[0]:g} to "
+                  f"{RECORD_DT_RANGE[1]:g} s of recorded ground motions (its {gm.acceleration.size} samples span "
+                  f"{gm.acceleration.size * gm.dt:.3g} s); check its dt ([{t.where}] dt, or the file's header or time column)")
     vert = t.raw("vertical", False)
     vcol = t.integer("vertical_column") if "vertical_column" in t.data else None
     if vcol is not None and not isinstance(vert, str):
