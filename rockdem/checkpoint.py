@@ -37,7 +37,7 @@ import tempfile
 import zipfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, Mapping, NamedTuple
 
 import numpy as np
 
@@ -45,7 +45,8 @@ from .kernels.layout import ModelArrays, Records, Scratch, State
 from .model import Model
 from .timestep import TimestepInfo
 
-__all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "load_checkpoint"]
+__all__ = ["Checkpoint", "FORMAT", "FORMAT_VERSION", "LOADING_FIELDS", "model_hash", "structure_hash", "field_hashes",
+           "model_differences", "load_checkpoint"]
 
 FORMAT = "rockdem-checkpoint"
 FORMAT_VERSION = 11
@@ -94,9 +95,7 @@ def _hash_model(model: Model, fields: tuple[str, ...], extra: tuple[str, ...]) -
 def model_hash(model: Model) -> str:
     """SHA-256 of every model array, the block and group names and the initial configuration:
     equal hashes mean the same model (and a continued run then equals an uninterrupted one)."""
-    extra = ("block_names", "group_names", "position0", "quaternion0", "quaternion_ref", "position_ref",
-             "velocity0", "omega0", "rocking_axis")
-    return _hash_model(model, ModelArrays._fields, extra)
+    return _hash_model(model, ModelArrays._fields, MODEL_EXTRAS)
 
 
 def structure_hash(model: Model) -> str:
@@ -104,6 +103,53 @@ def structure_hash(model: Model) -> str:
     :data:`LOADING_FIELDS`, with the block names and reference configuration."""
     fields = tuple(f for f in ModelArrays._fields if f not in LOADING_FIELDS)
     return _hash_model(model, fields, ("block_names", "group_names", "position0", "quaternion0"))
+
+
+MODEL_EXTRAS = ("block_names", "group_names", "position0", "quaternion0", "quaternion_ref", "position_ref",
+                "velocity0", "omega0", "rocking_axis")
+"""Model attributes beside its arrays that :func:`model_hash` covers."""
+
+
+def field_hashes(model: Model) -> dict[str, str]:
+    """A short hash per model array and per :data:`MODEL_EXTRAS` attribute, kept in a checkpoint so
+    that a model that differs can be told what differs (:func:`model_differences`)."""
+    out = {}
+    for name in ModelArrays._fields + MODEL_EXTRAS:
+        h = hashlib.sha256()
+        _digest(h, getattr(model.arrays, name) if name in ModelArrays._fields else getattr(model, name))
+        out[name] = h.hexdigest()[:16]
+    return out
+
+
+def _what(name: str) -> str:
+    """What a model array or attribute describes, in a case's words."""
+    if name in ("alpha", "alpha_relative", "local_damping", "mat_beta"):
+        return "the damping"
+    if name in LOADING_FIELDS or name in ("block_free", "rocking_axis"):
+        return "the loading (driven blocks, ground or body accelerations, its direction)"
+    if name.startswith("mat_"):
+        return "the joint materials"
+    if name in ("position0", "quaternion0", "quaternion_ref", "position_ref"):
+        return "the blocks' starting poses (a tilt is one)"
+    if name in ("velocity0", "omega0"):
+        return "the initial velocities"
+    if name in ("gravity", "contact_tol", "touch_tol", "block_names", "group_names"):
+        return {"gravity": "gravity", "block_names": "the block names", "group_names": "the joint groups"}.get(
+            name, "the contact tolerance")
+    if name.startswith(("point_", "cell_")):
+        return "the interface points"
+    return "the blocks' geometry, size or density"
+
+
+def model_differences(model: Model, saved: Mapping[str, str]) -> list[str]:
+    """What differs between ``model`` and the model whose :func:`field_hashes` are ``saved``, in a
+    case's words (each once, in the order of the arrays), with the arrays that differ."""
+    now = field_hashes(model)
+    groups: dict[str, list[str]] = {}
+    for name, h in now.items():
+        if name in saved and saved[name] != h:
+            groups.setdefault(_what(name), []).append(name)
+    return [f"{what} ({', '.join(names[:4])}{', ...' if len(names) > 4 else ''})" for what, names in groups.items()]
 
 
 def _copy(nt: NamedTuple) -> Any:
@@ -130,6 +176,8 @@ class Checkpoint:
         check_target: for a run with a stop rule (:mod:`rockdem.stopping`) whose end cut its last
             chunk short, the time [s] that chunk was to end at: a continuation ends its first chunk
             there, so that its stop checks fall where an uninterrupted run's do; else None.
+        field_hashes: the model's :func:`field_hashes` (None in files written before 2026-12-08), to
+            say what differs in a model it is refused for.
     """
 
     state: State
@@ -147,6 +195,7 @@ class Checkpoint:
     fresh: bool = False
     block_names: tuple[str, ...] = field(default_factory=tuple)
     check_target: float | None = None
+    field_hashes: dict[str, str] | None = None
 
     @property
     def time(self) -> float:
@@ -181,7 +230,7 @@ class Checkpoint:
                     "checkpoint with its clock reset starts only a model built as the one it was saved from, with the "
                     "same blocks and joints standing in the same poses (its loading and damping may differ; a tilt, "
                     "as a free-rocking release has, is a pose: tilt the blocks in the settling case too); checkpoint "
-                    f"blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}")
+                    f"blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}{self._differing(model)}")
             return
         if model_hash(model) != self.model_hash:
             same = structure_hash(model) == self.structure_hash
@@ -189,7 +238,14 @@ class Checkpoint:
                     "use Checkpoint.reset_clock() (rockdem run --settled)" if same else
                     f"checkpoint blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}")
             raise ValueError(f"the checkpoint was saved from another model (model hash {self.model_hash[:12]} vs "
-                             f"{model_hash(model)[:12]}); continue it with the same case and options; {hint}")
+                             f"{model_hash(model)[:12]}); continue it with the same case and options; {hint}"
+                             f"{self._differing(model)}")
+
+    def _differing(self, model: Model) -> str:
+        """'; what differs: ...' for a refused model (:func:`model_differences`), or '' without the
+        saved hashes."""
+        what = model_differences(model, self.field_hashes) if self.field_hashes else []
+        return f"; what differs: {'; '.join(what)}" if what else ""
 
     def save(self, path: PathLike) -> Path:
         """Write the checkpoint (atomically: a partial file never replaces a good one)."""
@@ -201,6 +257,7 @@ class Checkpoint:
             "contact_interval": self.contact_interval, "snapshot_count": self.snapshot_count,
             "timestep": self.timestep.__dict__, "runtime_s": self.runtime_s, "fresh": self.fresh,
             "block_names": list(self.block_names), "time": self.time, "check_target": self.check_target,
+            "field_hashes": self.field_hashes,
         }
         arrays: dict[str, np.ndarray] = {"meta": np.array(json.dumps(meta))}
         for prefix, nt in (("state", self.state), ("scratch", self.scratch), ("records", self.records)):
@@ -263,6 +320,7 @@ class Checkpoint:
             model_hash=meta["model_hash"], structure_hash=meta["structure_hash"], runtime_s=float(meta["runtime_s"]),
             fresh=bool(meta["fresh"]), block_names=tuple(meta["block_names"]),
             check_target=meta.get("check_target"),  # absent in files written before stop rules
+            field_hashes=meta.get("field_hashes"),  # absent in files written before 2026-12-08
         )
 
     def engine_arrays(self, model: Model) -> tuple[State, Scratch]:

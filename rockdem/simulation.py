@@ -45,7 +45,7 @@ import numpy as np
 import xarray as xr
 
 from ._warn import warn_user
-from .checkpoint import Checkpoint, load_checkpoint, model_hash, structure_hash
+from .checkpoint import Checkpoint, field_hashes, load_checkpoint, model_hash, structure_hash
 from .kernels.layout import STATUS_DIVERGED, STATUS_DONE, STATUS_GROW, STATUS_LOST, Records, Scratch, State, new_records
 from .kernels.step import DIVERGENCE_ERROR, advance, advance_parallel
 from .model import Model
@@ -634,6 +634,7 @@ class _Saver:
         self.model, self.run, self.path, self.every = model, run, path, every
         self.last = _time.perf_counter()
         self.hashes = (model_hash(model), structure_hash(model)) if path is not None else ("", "")
+        self.fields = field_hashes(model) if path is not None else None
 
     def save(self, state: State, scratch: Scratch, rec: Records, frame: int, snaps: ContactSnapshots,
              runtime: float, check_target: float | None) -> Path:
@@ -645,7 +646,7 @@ class _Saver:
             record_interval=self.run.record_interval, contact_interval=snaps.interval, snapshot_count=snaps.count,
             snapshots=snaps.columns() if snaps.interval else {}, timestep=self.run.info,
             model_hash=self.hashes[0], structure_hash=self.hashes[1], runtime_s=runtime,
-            block_names=self.model.block_names, check_target=check_target,
+            block_names=self.model.block_names, check_target=check_target, field_hashes=self.fields,
         )
         with _deferred_signals():
             p = ck.save(self.path)
