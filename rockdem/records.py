@@ -221,7 +221,7 @@ class GroundMotion:
             **kwargs: other :class:`GroundMotion` fields (source, description, start_time, direction).
         """
         unit = _parse_units(units)
-        acc = np.asarray(values, dtype=float) * unit.to_si
+        acc = _frozen_samples(values, "acceleration", name or "GroundMotion") * unit.to_si  # (checked before the conversion)
         return cls(acc, dt, name=name, units_in=unit.value, **kwargs)  # type: ignore[arg-type]
 
     def __repr__(self) -> str:
@@ -380,6 +380,10 @@ def _integral(y: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
     return cumulative_trapezoid(y, dx=dt, axis=0, initial=0.0)
 
 
+MAX_SAMPLE = 1e12
+"""Largest |sample| of a record accepted, in any units (a trillion m/s^2, or cm/s^2, or g)."""
+
+
 def _frozen_samples(values: ArrayLike, what: str, label: str) -> NDArray[np.float64]:
     arr = np.array(values, dtype=float)
     if arr.ndim != 1 or arr.size < 2:
@@ -388,6 +392,10 @@ def _frozen_samples(values: ArrayLike, what: str, label: str) -> NDArray[np.floa
     if bad.size:
         raise ValueError(f"{label}: {what} has {bad.size} non-finite value(s) (NaN or inf), first at "
                          f"sample {bad[0]}; clean the record before use")
+    bad = np.flatnonzero(np.abs(arr) > MAX_SAMPLE)
+    if bad.size:  # (1e300 overflowed to inf in the unit conversion, blamed on the scale, before 2026-12-08)
+        raise ValueError(f"{label}: {what} has {bad.size} value(s) beyond any plausible acceleration (|value| > "
+                         f"{MAX_SAMPLE:g}), first {arr[bad[0]]:g} at sample {bad[0]}; check the record's column and units")
     arr.setflags(write=False)
     return arr
 

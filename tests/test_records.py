@@ -466,6 +466,10 @@ def test_direction_vertical_and_resampling() -> None:
     np.testing.assert_allclose(fine.acceleration, fine.time / 0.1, rtol=1e-12, atol=1e-12)
     with pytest.raises(ValueError, match="non-finite"):
         GroundMotion(np.array([0.0, np.nan]), 0.01)
+    with warnings.catch_warnings():  # an absurd sample is named before the unit conversion overflows
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"big: acceleration has 1 value\(s\) beyond any plausible .* first 1e\+300 at sample 1"):
+            GroundMotion.from_samples([0.0, 1e300, 0.0], dt=0.01, units="g", name="big")
     with pytest.raises(ValueError, match="dt must be a positive"):
         GroundMotion(acc, 0.0)
 
