@@ -650,6 +650,8 @@ def _plot(args: argparse.Namespace) -> int:
             continue
         if why and kind == "capacity":
             raise ValueError(f"--kind capacity: {why}; capacity curves apply to pushover results")
+        if why and kind == "comparison":  # (drawn alone, labelled its own reference, before 2026-12-08)
+            raise ValueError(f"--kind comparison: {why}; give two or more RESULTs, or --measured FILE (time, value)")
         func = PLOTS[kind]
         kw: dict[str, object] = {}
         if kind in multi:

@@ -55,6 +55,11 @@ def test_every_plot_command_writes_an_image(result_files, tmp_path, kind, which,
         assert code == 2 and "not a pushover" in capsys.readouterr().err
         assert not out.exists()
         return
+    if kind == "comparison":  # one result alone (drawn as its own reference before 2026-12-08) ...
+        assert code == 2 and "nothing to compare; give two or more RESULTs, or --measured" in capsys.readouterr().err
+        assert not out.exists()
+        # ... and with itself, or a measured history
+        code = main(["plot", str(result_files[which]), str(result_files[which]), "--kind", kind, "-o", str(out), "--dpi", "50"])
     assert code == 0
     _nonempty_image(out)
 
