@@ -289,8 +289,8 @@ def _check_cases(specs: Sequence[RunSpec], per_record: int) -> None:
             first = first or exc
     if first is not None:
         n = len(specs) // per_record
-        raise ValueError(f"no run of the IDA can start ({'its record' if n == 1 else f'none of its {n} records'} with the "
-                         f"base case and settings gives a valid case; nothing was run): {first}")
+        raise ValueError(f"no run of the IDA can start ({'its record gives no' if n == 1 else f'none of its {n} records gives a'} valid "
+                         f"case with the base case and settings; nothing was run): {first}")
 
 
 STRONG_MOTION_SHARE = 0.95

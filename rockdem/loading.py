@@ -801,7 +801,7 @@ def _earthquake_settings(t: Table) -> dict[str, Any]:
     if not RECORD_DT_RANGE[0] <= gm.dt <= RECORD_DT_RANGE[1]:
         warn_user(f"[{t.where}] record {t.string('record')!r}: dt = {gm.dt:g} s lies far outside the {RECORD_DT_RANGE[0]:g} to "
                   f"{RECORD_DT_RANGE[1]:g} s of recorded ground motions (its {gm.acceleration.size} samples span "
-                  f"{gm.acceleration.size * gm.dt:.3g} s); check its dt ([{t.where}] dt, or the file's header or time column)")
+                  f"{(gm.acceleration.size - 1) * gm.dt:.3g} s); check its dt ([{t.where}] dt, or the file's header or time column)")
     vert = t.raw("vertical", False)
     vcol = t.integer("vertical_column") if "vertical_column" in t.data else None
     if vcol is not None and not isinstance(vert, str):

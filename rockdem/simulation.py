@@ -477,7 +477,7 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         # (below the step it took one snapshot per step at best; at 1e-12 s the clock stopped, the
         # snapshots piling up in memory, before 2026-12-08)
         raise ValueError(f"contact_interval = {snaps.interval:g} s is shorter than the time step ({info.dt:.4g} s): contact "
-                         f"snapshots are taken at steps, one per step at most; give contact_interval >= {info.dt:.4g} s")
+                         f"snapshots are taken at steps, one per step at most; give contact_interval >= {math.ceil(info.dt * 1e4 / 10.0 ** math.floor(math.log10(info.dt))) * 10.0 ** math.floor(math.log10(info.dt)) / 1e4:.5g} s")
     _check_motions(model, info.dt, duration)
     rec = _frames(model, duration, interval)
     if start is not None:

@@ -175,7 +175,7 @@ def test_an_ida_none_of_whose_runs_can_start_is_refused_before_running(tmp_path)
     with pytest.raises(ValueError, match=r"no run of the IDA can start \(none of its 2 records.*\[damping\] beta.*'abc'"):
         run_ida("free-rocking", _pulses(tmp_path), [0.2, 0.5], tmp_path / "ida", fixed={**FIXED, "damping.beta": "abc"},
                 duration=0.5, executor="serial", progress=False)
-    with pytest.raises(ValueError, match=r"no run of the IDA can start \(its record.*broken\.csv"):
+    with pytest.raises(ValueError, match=r"no run of the IDA can start \(its record gives no valid case.*broken\.csv"):
         run_ida("free-rocking", [_unreadable(tmp_path)], [0.2, 0.5], tmp_path / "ida", fixed=FIXED, duration=0.5,
                 executor="serial", progress=False)
     for records, levels in (([], [0.2]), (_pulses(tmp_path), []), ("pulse1.csv", [0.2])):
