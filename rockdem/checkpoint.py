@@ -92,6 +92,15 @@ def _hash_model(model: Model, fields: tuple[str, ...], extra: tuple[str, ...]) -
     return h.hexdigest()
 
 
+MODEL_EXTRAS = ("block_names", "group_names", "position0", "quaternion0", "quaternion_ref", "position_ref",
+                "velocity0", "omega0", "rocking_axis")
+"""Model attributes beside its arrays that :func:`model_hash` covers."""
+
+STRUCTURE_FIELDS = tuple(f for f in ModelArrays._fields if f not in LOADING_FIELDS)
+STRUCTURE_EXTRAS = ("block_names", "group_names", "position0", "quaternion0")
+"""The model arrays and attributes that :func:`structure_hash` covers."""
+
+
 def model_hash(model: Model) -> str:
     """SHA-256 of every model array, the block and group names and the initial configuration:
     equal hashes mean the same model (and a continued run then equals an uninterrupted one)."""
@@ -101,13 +110,9 @@ def model_hash(model: Model) -> str:
 def structure_hash(model: Model) -> str:
     """SHA-256 of the blocks, geometry, interface points and joint materials: the model arrays less
     :data:`LOADING_FIELDS`, with the block names and reference configuration."""
-    fields = tuple(f for f in ModelArrays._fields if f not in LOADING_FIELDS)
-    return _hash_model(model, fields, ("block_names", "group_names", "position0", "quaternion0"))
+    return _hash_model(model, STRUCTURE_FIELDS, STRUCTURE_EXTRAS)
 
 
-MODEL_EXTRAS = ("block_names", "group_names", "position0", "quaternion0", "quaternion_ref", "position_ref",
-                "velocity0", "omega0", "rocking_axis")
-"""Model attributes beside its arrays that :func:`model_hash` covers."""
 
 
 def field_hashes(model: Model) -> dict[str, str]:
@@ -125,29 +130,33 @@ def _what(name: str) -> str:
     """What a model array or attribute describes, in a case's words."""
     if name in ("alpha", "alpha_relative", "local_damping", "mat_beta"):
         return "the damping"
-    if name in LOADING_FIELDS or name in ("block_free", "rocking_axis"):
-        return "the loading (driven blocks, ground or body accelerations, its direction)"
+    if name in LOADING_FIELDS or name == "rocking_axis":
+        return "the loading (driven motions, ground or body accelerations, its direction)"
+    if name == "block_free":
+        return "which blocks are driven"
     if name.startswith("mat_"):
         return "the joint materials"
     if name in ("position0", "quaternion0", "quaternion_ref", "position_ref"):
         return "the blocks' starting poses (a tilt is one)"
     if name in ("velocity0", "omega0"):
         return "the initial velocities"
-    if name in ("gravity", "contact_tol", "touch_tol", "block_names", "group_names"):
-        return {"gravity": "gravity", "block_names": "the block names", "group_names": "the joint groups"}.get(
-            name, "the contact tolerance")
+    if name in ("gravity", "contact_tol", "touch_tol", "block_names", "group_names", "block_group"):
+        return {"gravity": "gravity", "block_names": "the block names", "contact_tol": "the contact tolerance",
+                "touch_tol": "the contact tolerance"}.get(name, "the joint groups")
     if name.startswith(("point_", "cell_")):
         return "the interface points"
     return "the blocks' geometry, size or density"
 
 
-def model_differences(model: Model, saved: Mapping[str, str]) -> list[str]:
+def model_differences(model: Model, saved: Mapping[str, str], structure: bool = False) -> list[str]:
     """What differs between ``model`` and the model whose :func:`field_hashes` are ``saved``, in a
-    case's words (each once, in the order of the arrays), with the arrays that differ."""
+    case's words (each once, in the order of the arrays), with the arrays that differ; with
+    ``structure`` only what :func:`structure_hash` covers (the loading and damping may differ)."""
     now = field_hashes(model)
+    covered = set(STRUCTURE_FIELDS + STRUCTURE_EXTRAS) if structure else set(now)
     groups: dict[str, list[str]] = {}
     for name, h in now.items():
-        if name in saved and saved[name] != h:
+        if name in covered and name in saved and saved[name] != h:
             groups.setdefault(_what(name), []).append(name)
     return [f"{what} ({', '.join(names[:4])}{', ...' if len(names) > 4 else ''})" for what, names in groups.items()]
 
@@ -230,7 +239,7 @@ class Checkpoint:
                     "checkpoint with its clock reset starts only a model built as the one it was saved from, with the "
                     "same blocks and joints standing in the same poses (its loading and damping may differ; a tilt, "
                     "as a free-rocking release has, is a pose: tilt the blocks in the settling case too); checkpoint "
-                    f"blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}{self._differing(model)}")
+                    f"blocks: {_names(self.block_names)}, model blocks: {_names(model.block_names)}{self._differing(model, structure=True)}")
             return
         if model_hash(model) != self.model_hash:
             same = structure_hash(model) == self.structure_hash
@@ -241,10 +250,10 @@ class Checkpoint:
                              f"{model_hash(model)[:12]}); continue it with the same case and options; {hint}"
                              f"{self._differing(model)}")
 
-    def _differing(self, model: Model) -> str:
+    def _differing(self, model: Model, structure: bool = False) -> str:
         """'; what differs: ...' for a refused model (:func:`model_differences`), or '' without the
         saved hashes."""
-        what = model_differences(model, self.field_hashes) if self.field_hashes else []
+        what = model_differences(model, self.field_hashes, structure) if self.field_hashes else []
         return f"; what differs: {'; '.join(what)}" if what else ""
 
     def save(self, path: PathLike) -> Path:

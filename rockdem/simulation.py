@@ -473,11 +473,12 @@ def _fresh_run(model: Model, duration: float, ck: Checkpoint | None, dt: float |
         raise ValueError(f"record_interval = {interval:g} s puts {info.dt / interval:.3g} frames in each time step "
                          f"({info.dt:.4g} s), all interpolated between the same two steps (more than {FRAMES_PER_STEP}); "
                          f"give record_interval >= {info.dt / FRAMES_PER_STEP:.3g} s, or the step itself")
-    if snaps.interval is not None and snaps.interval < info.dt:
-        # (below the step it took one snapshot per step at best; at 1e-12 s the clock stopped, the
-        # snapshots piling up in memory, before 2026-12-08)
-        raise ValueError(f"contact_interval = {snaps.interval:g} s is shorter than the time step ({info.dt:.4g} s): contact "
-                         f"snapshots are taken at steps, one per step at most; give contact_interval >= {math.ceil(info.dt * 1e4 / 10.0 ** math.floor(math.log10(info.dt))) * 10.0 ** math.floor(math.log10(info.dt)) / 1e4:.5g} s")
+    if snaps.interval is not None and snaps.interval < 0.5 * info.dt:
+        # Snapshots are taken at steps, one per step at most (an interval just under the step takes
+        # one at every step); far below it the clock stopped, at 1e-12 s, the snapshots piling up
+        # in memory (before 2026-12-08).
+        raise ValueError(f"contact_interval = {snaps.interval:g} s is less than half the time step ({info.dt:.4g} s): contact "
+                         f"snapshots are taken at steps, one per step at most; give contact_interval >= {info.dt:.3g} s")
     _check_motions(model, info.dt, duration)
     rec = _frames(model, duration, interval)
     if start is not None:

@@ -100,6 +100,10 @@ def test_checkpoint_refuses_another_model_or_other_options(case, tmp_path):
         simulate(taller, 0.2, initial=tmp_path / "c.npz", progress=False)
     with pytest.raises(ValueError, match="blocks, geometry, joint materials or starting poses.*what differs: the blocks' geometry"):
         simulate(taller, 0.2, initial=Checkpoint.load(tmp_path / "c.npz").reset_clock(), progress=False)
+    # a settled start lists only what it may not differ in: not the damping, which it may
+    taller_damped = parse_case(apply_overrides(example_case("free-rocking"), ["specimen.height=2.5", "damping.beta=0.001"])).model
+    with pytest.raises(ValueError, match=r"what differs: (?!.*damping).*\(position0"):
+        simulate(taller_damped, 0.2, initial=Checkpoint.load(tmp_path / "c.npz").reset_clock(), progress=False)
     with pytest.raises(ValueError, match="record_interval = 0.02 differs"):
         simulate(case.model, 0.2, initial=tmp_path / "c.npz", record_interval=0.02, progress=False)
     # a finished run: its last frame is at its end, 0.1 s (the state a step past it); an end that
